@@ -1,0 +1,5 @@
+//! Host-side (std) tools around `pdm-kernel`: the `pdm` command line, independent reference
+//! values, the Gauss–Legendre table generator, validation and sweeps.
+
+pub mod gauss_gen;
+pub mod reference;

@@ -1,0 +1,2 @@
+//! The `pdm` command line.
+fn main() {}

@@ -1,0 +1,60 @@
+//! The kernel's error type: every bad input is an `Err`, never a panic or a NaN.
+
+use core::fmt;
+
+/// Why a kernel computation was refused.
+///
+/// Every public entry point validates its input and returns one of these instead of panicking or
+/// returning a non-finite number.
+#[non_exhaustive]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum PdmError {
+    /// A Gauss–Legendre order outside `1..=MAX_ORDER`.
+    UnsupportedOrder {
+        /// The order that was asked for.
+        order: usize,
+    },
+    /// A coordinate, parameter, radius or other input was NaN or infinite, or a surface evaluated
+    /// to a non-finite point or normal.
+    NonFinite,
+    /// A parameter interval with `start >= end` (or a zero-size subdivision).
+    EmptyParameterRange,
+    /// A patch or surface whose area is zero or negative (collinear edges, zero radius, a patch
+    /// collapsed onto a pole…), or a shape parameter that makes the surface degenerate.
+    Degenerate,
+    /// A patch range that is not inside its surface's parameter domain.
+    OutsideDomain,
+    /// A fixed-capacity buffer (sample buffer, occluder list) is too small for the request.
+    CapacityExceeded {
+        /// Entries needed.
+        needed: usize,
+        /// Entries available.
+        capacity: usize,
+    },
+    /// The computed form factor was not a finite number in [0, 1 + tolerance] (indicates input
+    /// geometry the method cannot handle, e.g. interpenetrating patches).
+    InvalidResult,
+}
+
+impl fmt::Display for PdmError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::UnsupportedOrder { order } => write!(
+                f,
+                "unsupported Gauss-Legendre order {order} (supported: 1..={})",
+                crate::gauss::MAX_ORDER
+            ),
+            Self::NonFinite => f.write_str("non-finite (NaN or infinite) input or intermediate value"),
+            Self::EmptyParameterRange => f.write_str("empty parameter range (start >= end)"),
+            Self::Degenerate => f.write_str("degenerate geometry (zero area or invalid shape parameter)"),
+            Self::OutsideDomain => f.write_str("patch parameter range lies outside the surface's domain"),
+            Self::CapacityExceeded { needed, capacity } => {
+                write!(f, "fixed capacity exceeded: need {needed}, have {capacity}")
+            }
+            Self::InvalidResult => f.write_str("form factor is not a finite number in [0, 1]"),
+        }
+    }
+}
+
+impl core::error::Error for PdmError {}

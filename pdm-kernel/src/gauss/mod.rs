@@ -1,0 +1,186 @@
+//! Fixed-order Gauss–Legendre rules on [−1, 1], orders 1 to [`MAX_ORDER`].
+//!
+//! An n-point rule integrates every polynomial of degree ≤ 2n − 1 exactly (up to rounding); on
+//! an integrand analytic in a Bernstein ellipse of parameter ρ around [−1, 1] the error falls like
+//! ρ^(−2n). The nodes and weights live in the generated file `tables.rs`: bit-exact
+//! (correctly rounded) for f64, and correctly rounded from the high-precision value for f32 (not
+//! rounded through f64). The host test `gauss_tables_are_bit_exact` in `pdm-host` regenerates them
+//! with multi-precision arithmetic and fails if any bit differs.
+//!
+//! Nodes are stored sorted ascending; node k and node n−1−k are negatives of each other.
+
+pub(crate) mod tables;
+
+use crate::error::PdmError;
+use crate::real::Real;
+
+/// The largest tabulated order (number of points per axis).
+pub const MAX_ORDER: usize = tables::MAX_ORDER;
+
+/// A validated Gauss–Legendre rule: an order in `1..=MAX_ORDER` and its table.
+///
+/// Construct with [`GaussRule::new`]; an order outside the table is an [`PdmError::UnsupportedOrder`].
+#[derive(Clone, Copy, Debug)]
+pub struct GaussRule<T: Real> {
+    nodes: &'static [T],
+    weights: &'static [T],
+}
+
+impl<T: Real> GaussRule<T> {
+    /// The n-point rule, or `Err(UnsupportedOrder)` if `order` is 0 or above [`MAX_ORDER`].
+    pub fn new(order: usize) -> Result<Self, PdmError> {
+        match T::gauss_table(order) {
+            Some((nodes, weights)) => Ok(Self { nodes, weights }),
+            None => Err(PdmError::UnsupportedOrder { order }),
+        }
+    }
+
+    /// Number of points n.
+    #[inline]
+    #[must_use]
+    pub fn order(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// Nodes on [−1, 1], ascending.
+    #[inline]
+    #[must_use]
+    pub fn nodes(&self) -> &'static [T] {
+        self.nodes
+    }
+
+    /// Weights, summing to 2.
+    #[inline]
+    #[must_use]
+    pub fn weights(&self) -> &'static [T] {
+        self.weights
+    }
+
+    /// (node, weight) pairs.
+    #[inline]
+    pub fn points(&self) -> impl Iterator<Item = (T, T)> + '_ {
+        self.nodes.iter().copied().zip(self.weights.iter().copied())
+    }
+
+    /// ∫ₐᵇ f(x) dx by this rule (exact for polynomials of degree ≤ 2n − 1).
+    pub fn integrate(&self, a: T, b: T, mut f: impl FnMut(T) -> T) -> T {
+        let half = (b - a) * T::HALF;
+        let mid = (a + b) * T::HALF;
+        let mut sum = T::ZERO;
+        for (x, w) in self.points() {
+            sum += w * f(mid + half * x);
+        }
+        sum * half
+    }
+}
+
+/// Slices order `order` out of one flat generated table; `None` outside `1..=MAX_ORDER`.
+pub(crate) fn rule_slices<T>(
+    nodes: &'static [T],
+    weights: &'static [T],
+    order: usize,
+) -> Option<(&'static [T], &'static [T])> {
+    if order == 0 || order > tables::MAX_ORDER {
+        return None;
+    }
+    let start = *tables::OFFSETS.get(order)?;
+    let end = *tables::OFFSETS.get(order + 1)?;
+    Some((nodes.get(start..end)?, weights.get(start..end)?))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn weights_sum_to_two<T: Real>(tol: f64) {
+        for n in 1..=MAX_ORDER {
+            let rule = GaussRule::<T>::new(n).unwrap();
+            let s: f64 = rule.weights().iter().map(|w| w.to_f64()).sum();
+            assert!((s - 2.0).abs() <= tol, "order {n}: weights sum to {s}");
+        }
+    }
+
+    fn nodes_symmetric_sorted<T: Real>() {
+        for n in 1..=MAX_ORDER {
+            let rule = GaussRule::<T>::new(n).unwrap();
+            assert_eq!(rule.order(), n);
+            let x = rule.nodes();
+            let w = rule.weights();
+            for k in 0..n {
+                assert_eq!(x[k], -x[n - 1 - k], "order {n} node {k} not symmetric");
+                assert_eq!(w[k], w[n - 1 - k], "order {n} weight {k} not symmetric");
+                assert!(x[k] > -T::ONE && x[k] < T::ONE);
+                assert!(w[k] > T::ZERO);
+                if k > 0 {
+                    assert!(x[k - 1] < x[k], "order {n} not sorted at {k}");
+                }
+            }
+        }
+    }
+
+    /// ∫₋₁¹ x^d dx = 2/(d+1) for even d, 0 for odd d.
+    fn exact_for_degree_2n_minus_1<T: Real>(unit_tol: f64) {
+        for n in 1..=MAX_ORDER {
+            // Rounding of the stored nodes perturbs x^d by about d·ε.
+            let tol = unit_tol * (2 * n) as f64;
+            let rule = GaussRule::<T>::new(n).unwrap();
+            for d in 0..2 * n {
+                let got: f64 = rule
+                    .points()
+                    .map(|(x, w)| w.to_f64() * x.to_f64().powi(d as i32))
+                    .sum();
+                let exact = if d % 2 == 0 { 2.0 / (d as f64 + 1.0) } else { 0.0 };
+                assert!(
+                    (got - exact).abs() <= tol,
+                    "order {n}, degree {d}: {got} vs {exact}"
+                );
+            }
+            // And the rule is not exact at degree 2n (so the test can fail): x^{2n} is off by
+            // 2^{2n+1}(n!)^4/((2n+1)((2n)!)^2), which is far above rounding for small n.
+            if n > 4 {
+                continue;
+            }
+            let d = 2 * n;
+            let got: f64 = rule.points().map(|(x, w)| w.to_f64() * x.to_f64().powi(d as i32)).sum();
+            assert!((got - 2.0 / (d as f64 + 1.0)).abs() > tol, "order {n} exact at degree 2n?");
+        }
+    }
+
+    #[test]
+    fn weights_f64() {
+        weights_sum_to_two::<f64>(4.0 * f64::EPSILON * 2.0 * 32.0);
+    }
+    #[test]
+    fn weights_f32() {
+        weights_sum_to_two::<f32>(2.0 * f32::EPSILON as f64 * 32.0);
+    }
+    #[test]
+    fn symmetric_f64() {
+        nodes_symmetric_sorted::<f64>();
+    }
+    #[test]
+    fn symmetric_f32() {
+        nodes_symmetric_sorted::<f32>();
+    }
+    #[test]
+    fn polynomial_exactness_f64() {
+        exact_for_degree_2n_minus_1::<f64>(8.0 * f64::EPSILON);
+    }
+    #[test]
+    fn polynomial_exactness_f32() {
+        exact_for_degree_2n_minus_1::<f32>(8.0 * f32::EPSILON as f64);
+    }
+    #[test]
+    fn unsupported_orders_are_errors() {
+        assert!(matches!(GaussRule::<f64>::new(0), Err(PdmError::UnsupportedOrder { order: 0 })));
+        assert!(GaussRule::<f32>::new(MAX_ORDER + 1).is_err());
+        assert!(GaussRule::<f64>::new(usize::MAX).is_err());
+    }
+    #[test]
+    fn integrate_maps_interval() {
+        let r = GaussRule::<f64>::new(3).unwrap();
+        // ∫_1^3 x^5 dx = (729 - 1)/6
+        let v = r.integrate(1.0, 3.0, |x| x.powi(5));
+        assert!((v - 728.0 / 6.0).abs() < 1e-12);
+    }
+}

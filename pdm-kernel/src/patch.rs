@@ -1,0 +1,242 @@
+//! Patches: a surface restricted to a sub-rectangle of its parameter domain, subdivision into
+//! m × n grids without allocation, and patch areas by eq. (12).
+
+use crate::error::PdmError;
+use crate::gauss::GaussRule;
+use crate::real::Real;
+use crate::surface::{ParamRect, Surface};
+
+/// A surface restricted to the parameter rectangle `rect` ⊆ its domain.
+#[derive(Debug)]
+pub struct Patch<'s, T, S: ?Sized> {
+    surface: &'s S,
+    rect: ParamRect<T>,
+}
+
+impl<T, S: ?Sized> Clone for Patch<'_, T, S>
+where
+    T: Copy,
+{
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+impl<T: Copy, S: ?Sized> Copy for Patch<'_, T, S> {}
+
+impl<'s, T: Real, S: Surface<T> + ?Sized> Patch<'s, T, S> {
+    /// The patch of `surface` over `rect`. `Err(NonFinite)`/`Err(EmptyParameterRange)` for a bad
+    /// rectangle, `Err(OutsideDomain)` if it leaves the surface's domain (beyond rounding).
+    pub fn new(surface: &'s S, rect: ParamRect<T>) -> Result<Self, PdmError> {
+        rect.validate()?;
+        if !surface.domain().contains(&rect) {
+            return Err(PdmError::OutsideDomain);
+        }
+        Ok(Self { surface, rect })
+    }
+
+    /// The whole surface as one patch.
+    pub fn whole(surface: &'s S) -> Result<Self, PdmError> {
+        Self::new(surface, surface.domain())
+    }
+
+    /// The surface.
+    #[must_use]
+    pub fn surface(&self) -> &'s S {
+        self.surface
+    }
+
+    /// The parameter rectangle.
+    #[must_use]
+    pub fn rect(&self) -> ParamRect<T> {
+        self.rect
+    }
+
+    /// Area by eq. (12), A = ∫∫ |n| ds dt, with the `order`-point Gauss rule on each axis.
+    /// Exact (to rounding) when |n| is a polynomial of degree ≤ 2·order − 1 in each parameter
+    /// (parallelograms, disks, cylinders); for the sphere zone the error falls like ρ^(−2·order).
+    /// `Err` for an unsupported order, a non-finite normal, or a zero area.
+    pub fn area(&self, order: usize) -> Result<T, PdmError> {
+        let rule = GaussRule::<T>::new(order)?;
+        let r = self.rect;
+        let ht = (r.t1 - r.t0) * T::HALF;
+        let hs = (r.s1 - r.s0) * T::HALF;
+        let mut sum = T::ZERO;
+        for (xt, wt) in rule.points() {
+            let t = r.t0 + ht * (xt + T::ONE);
+            let mut row = T::ZERO;
+            for (xs, ws) in rule.points() {
+                let s = r.s0 + hs * (xs + T::ONE);
+                let n = self.surface.normal(t, s);
+                if !n.is_finite() {
+                    return Err(PdmError::NonFinite);
+                }
+                row += ws * n.norm();
+            }
+            sum += wt * row;
+        }
+        let area = sum * ht * hs;
+        if !area.is_finite() {
+            return Err(PdmError::NonFinite);
+        }
+        if !(area > T::ZERO) {
+            return Err(PdmError::Degenerate);
+        }
+        Ok(area)
+    }
+
+    /// The m × n grid of sub-patches of this patch (m along t, n along s), as an iterator.
+    pub fn grid(&self, m: usize, n: usize) -> Result<PatchGrid<'s, T, S>, PdmError> {
+        PatchGrid::over(self.surface, self.rect, m, n)
+    }
+}
+
+/// An m × n grid of patches over a parameter rectangle; iterates row by row (t index outer),
+/// without allocating. Neighbouring patches share their parameter bounds exactly.
+#[derive(Debug)]
+pub struct PatchGrid<'s, T, S: ?Sized> {
+    surface: &'s S,
+    rect: ParamRect<T>,
+    m: usize,
+    n: usize,
+    next: usize,
+}
+
+impl<T: Copy, S: ?Sized> Clone for PatchGrid<'_, T, S> {
+    fn clone(&self) -> Self {
+        Self { surface: self.surface, rect: self.rect, m: self.m, n: self.n, next: self.next }
+    }
+}
+
+impl<'s, T: Real, S: Surface<T> + ?Sized> PatchGrid<'s, T, S> {
+    /// The m × n grid over the whole domain of `surface`.
+    pub fn new(surface: &'s S, m: usize, n: usize) -> Result<Self, PdmError> {
+        Self::over(surface, surface.domain(), m, n)
+    }
+
+    /// The m × n grid over `rect`. `Err(EmptyParameterRange)` if m or n is 0; `Err` for a bad rect.
+    pub fn over(surface: &'s S, rect: ParamRect<T>, m: usize, n: usize) -> Result<Self, PdmError> {
+        if m == 0 || n == 0 {
+            return Err(PdmError::EmptyParameterRange);
+        }
+        rect.validate()?;
+        if !surface.domain().contains(&rect) {
+            return Err(PdmError::OutsideDomain);
+        }
+        Ok(Self { surface, rect, m, n, next: 0 })
+    }
+
+    /// Grid size (m, n).
+    #[must_use]
+    pub fn dims(&self) -> (usize, usize) {
+        (self.m, self.n)
+    }
+
+    /// Number of patches, m·n.
+    #[must_use]
+    pub fn count(&self) -> usize {
+        self.m * self.n
+    }
+
+    /// Patch (i, j): i-th along t, j-th along s; `None` outside the grid.
+    #[must_use]
+    pub fn cell(&self, i: usize, j: usize) -> Option<Patch<'s, T, S>> {
+        if i >= self.m || j >= self.n {
+            return None;
+        }
+        Some(Patch { surface: self.surface, rect: self.rect.cell(i, j, self.m, self.n) })
+    }
+}
+
+impl<'s, T: Real, S: Surface<T> + ?Sized> Iterator for PatchGrid<'s, T, S> {
+    type Item = Patch<'s, T, S>;
+    fn next(&mut self) -> Option<Self::Item> {
+        if self.next >= self.m * self.n {
+            return None;
+        }
+        let k = self.next;
+        self.next += 1;
+        self.cell(k / self.n, k % self.n)
+    }
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        let left = (self.m * self.n).saturating_sub(self.next);
+        (left, Some(left))
+    }
+}
+
+impl<T: Real, S: Surface<T> + ?Sized> ExactSizeIterator for PatchGrid<'_, T, S> {}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::surface::{Cylinder, Parallelogram, Side, Sphere};
+    use crate::vec3::vec3;
+
+    #[test]
+    fn sphere_zone_area_converges_to_exact() {
+        // Zone between polar angles φ0 and φ1 over the full circle: 2πR²(cos φ0 − cos φ1).
+        let r = 1.7;
+        let s = Sphere::outer(vec3(0.0, 0.0, 0.0), r).unwrap();
+        let (p0, p1) = (0.3_f64, 1.9_f64);
+        let rect = ParamRect::new(p0, p1, 0.0, 2.0 * core::f64::consts::PI).unwrap();
+        let exact = 2.0 * core::f64::consts::PI * r * r * (p0.cos() - p1.cos());
+        let patch = Patch::new(&s, rect).unwrap();
+        let coarse = (patch.area(3).unwrap() - exact).abs() / exact;
+        let fine = (patch.area(12).unwrap() - exact).abs() / exact;
+        assert!(coarse > 1e-6, "order 3 should not be exact: {coarse}");
+        assert!(fine < 1e-14, "order 12 relative error {fine}");
+        // f32
+        let s32 = Sphere::outer(vec3(0.0_f32, 0.0, 0.0), r as f32).unwrap();
+        let rect32 = ParamRect::new(p0 as f32, p1 as f32, 0.0, 2.0 * core::f32::consts::PI).unwrap();
+        let a32 = Patch::new(&s32, rect32).unwrap().area(12).unwrap() as f64;
+        assert!((a32 - exact).abs() / exact < 2e-6, "f32 {a32} vs {exact}");
+    }
+
+    #[test]
+    fn whole_sphere_area() {
+        let s = Sphere::outer(vec3(1.0, 2.0, 3.0), 2.0).unwrap();
+        let total: f64 = PatchGrid::new(&s, 8, 16).unwrap().map(|p| p.area(8).unwrap()).sum();
+        let exact = 4.0 * core::f64::consts::PI * 4.0;
+        assert!((total - exact).abs() / exact < 1e-14);
+    }
+
+    #[test]
+    fn cylinder_band_and_parallelogram_areas_are_exact() {
+        let c = Cylinder::new(vec3(0.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0), 0.8, 3.0, Side::Inner).unwrap();
+        let band = Patch::new(&c, ParamRect::new(0.5, 2.0, 1.0, 2.5).unwrap()).unwrap();
+        let exact = 0.8 * 1.5 * 1.5;
+        assert!((band.area(2).unwrap() - exact).abs() / exact < 1e-15);
+        let p = Parallelogram::new(vec3(0.0, 0.0, 0.0), vec3(2.0, 0.0, 0.0), vec3(0.5, 3.0, 0.0)).unwrap();
+        assert!((Patch::whole(&p).unwrap().area(1).unwrap() - 6.0).abs() < 1e-15);
+        let p32 = Parallelogram::new(vec3(0.0_f32, 0.0, 0.0), vec3(2.0, 0.0, 0.0), vec3(0.5, 3.0, 0.0)).unwrap();
+        assert_eq!(Patch::whole(&p32).unwrap().area(1).unwrap(), 6.0);
+    }
+
+    #[test]
+    fn grid_iterates_every_cell_once_and_tiles_the_domain() {
+        let s = Sphere::outer(vec3(0.0, 0.0, 0.0), 1.0).unwrap();
+        let g = PatchGrid::new(&s, 4, 8).unwrap();
+        assert_eq!(g.len(), 32);
+        let cells: heapless::Vec<_, 32> = g.map(|p| p.rect()).collect();
+        assert_eq!(cells.len(), 32);
+        assert_eq!(cells[0].t0, 0.0);
+        assert_eq!(cells[31].t1, core::f64::consts::PI);
+        assert_eq!(cells[31].s1, 2.0 * core::f64::consts::PI);
+        assert_eq!(cells[0].s1, cells[1].s0);
+        assert_eq!(cells[0].t1, cells[8].t0);
+    }
+
+    #[test]
+    fn bad_patches_are_errors() {
+        let s = Sphere::outer(vec3(0.0, 0.0, 0.0), 1.0).unwrap();
+        assert_eq!(PatchGrid::new(&s, 0, 3).err(), Some(PdmError::EmptyParameterRange));
+        let outside = ParamRect { t0: -1.0, t1: 1.0, s0: 0.0, s1: 1.0 };
+        assert_eq!(Patch::new(&s, outside).err(), Some(PdmError::OutsideDomain));
+        let nan = ParamRect { t0: f64::NAN, t1: 1.0, s0: 0.0, s1: 1.0 };
+        assert_eq!(Patch::new(&s, nan).err(), Some(PdmError::NonFinite));
+        let empty = ParamRect { t0: 1.0, t1: 1.0, s0: 0.0, s1: 1.0 };
+        assert_eq!(Patch::new(&s, empty).err(), Some(PdmError::EmptyParameterRange));
+        let whole = Patch::whole(&s).unwrap();
+        assert_eq!(whole.area(0).err(), Some(PdmError::UnsupportedOrder { order: 0 }));
+        assert_eq!(whole.area(33).err(), Some(PdmError::UnsupportedOrder { order: 33 }));
+    }
+}

@@ -1,0 +1,209 @@
+//! Gauss sample points of a patch, precomputed once and reused against every other patch.
+//!
+//! [`PatchSamples`] holds, for the p_t × p_s Gauss nodes of a patch, the point g(t, s), the unit
+//! normal n/|n| and the weight w_t w_s J |n| (Gauss weights × interval Jacobian × area element),
+//! so that Σ w = A (eq. 12) and ∫∫ f dA ≈ Σ w f. Arrays are fixed-size (structure of arrays,
+//! capacity `CAP` chosen by the caller: 25 for order 5, 1024 for order 32), so sampling needs
+//! no heap.
+//!
+//! Where the area element vanishes (a sphere's pole, the apex of a cone) the weight is zero and
+//! the unit normal is set to zero: such a point contributes nothing and nothing is divided by |n|.
+
+use crate::error::PdmError;
+use crate::gauss::GaussRule;
+use crate::patch::Patch;
+use crate::real::Real;
+use crate::surface::Surface;
+use crate::vec3::{vec3, Vec3};
+
+/// A ball (centre, radius) bounding a set of points.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Ball<T> {
+    /// Centre.
+    pub center: Vec3<T>,
+    /// Radius.
+    pub radius: T,
+}
+
+/// Precomputed Gauss samples of one patch (at most `CAP` of them).
+#[derive(Clone, Debug)]
+pub struct PatchSamples<T, const CAP: usize> {
+    pub(crate) len: usize,
+    pub(crate) x: [T; CAP],
+    pub(crate) y: [T; CAP],
+    pub(crate) z: [T; CAP],
+    pub(crate) nx: [T; CAP],
+    pub(crate) ny: [T; CAP],
+    pub(crate) nz: [T; CAP],
+    pub(crate) w: [T; CAP],
+    pub(crate) area: T,
+    pub(crate) bounds: Ball<T>,
+}
+
+impl<T: Real, const CAP: usize> PatchSamples<T, CAP> {
+    /// Samples `patch` with the `order`-point rule on both axes.
+    pub fn new<S: Surface<T> + ?Sized>(patch: &Patch<'_, T, S>, order: usize) -> Result<Self, PdmError> {
+        Self::with_orders(patch, order, order)
+    }
+
+    /// Samples `patch` with `order_t` points along t and `order_s` along s.
+    ///
+    /// Errors: `UnsupportedOrder`; `CapacityExceeded` if `order_t·order_s > CAP`; `NonFinite` if
+    /// the surface evaluates to NaN/∞; `Degenerate` if the patch area is zero (or below
+    /// (2¹²ε)² of its squared extent) or not finite.
+    pub fn with_orders<S: Surface<T> + ?Sized>(
+        patch: &Patch<'_, T, S>,
+        order_t: usize,
+        order_s: usize,
+    ) -> Result<Self, PdmError> {
+        let rule_t = GaussRule::<T>::new(order_t)?;
+        let rule_s = GaussRule::<T>::new(order_s)?;
+        let needed = order_t * order_s;
+        if needed > CAP {
+            return Err(PdmError::CapacityExceeded { needed, capacity: CAP });
+        }
+        let mut out = Self {
+            len: 0,
+            x: [T::ZERO; CAP],
+            y: [T::ZERO; CAP],
+            z: [T::ZERO; CAP],
+            nx: [T::ZERO; CAP],
+            ny: [T::ZERO; CAP],
+            nz: [T::ZERO; CAP],
+            w: [T::ZERO; CAP],
+            area: T::ZERO,
+            bounds: Ball { center: Vec3::ZERO, radius: T::ZERO },
+        };
+        let r = patch.rect();
+        let surface = patch.surface();
+        let ht = (r.t1 - r.t0) * T::HALF;
+        let hs = (r.s1 - r.s0) * T::HALF;
+        let jacobian = ht * hs;
+        let mut k = 0;
+        let mut area = T::ZERO;
+        for (xt, wt) in rule_t.points() {
+            let t = r.t0 + ht * (xt + T::ONE);
+            for (xs, ws) in rule_s.points() {
+                let s = r.s0 + hs * (xs + T::ONE);
+                let (p, n) = surface.point_and_normal(t, s);
+                if !(p.is_finite() && n.is_finite()) {
+                    return Err(PdmError::NonFinite);
+                }
+                let len = n.norm();
+                let unit = if len > T::ZERO { n.scale(T::ONE / len) } else { Vec3::ZERO };
+                let w = wt * ws * jacobian * len;
+                out.set(k, p, unit, w);
+                area += w;
+                k += 1;
+            }
+        }
+        out.len = k;
+        if !area.is_finite() {
+            return Err(PdmError::NonFinite);
+        }
+        out.area = area;
+        out.bounds = out.compute_bounds();
+        let extent = out.bounds.radius * T::TWO;
+        let tiny = T::GEOMETRY_TOLERANCE * T::GEOMETRY_TOLERANCE * extent * extent;
+        if !(area > T::ZERO) || !(area > tiny) || !out.bounds.radius.is_finite() {
+            return Err(PdmError::Degenerate);
+        }
+        Ok(out)
+    }
+
+    fn set(&mut self, k: usize, p: Vec3<T>, n: Vec3<T>, w: T) {
+        if let (Some(x), Some(y), Some(z), Some(nx), Some(ny), Some(nz), Some(wk)) = (
+            self.x.get_mut(k),
+            self.y.get_mut(k),
+            self.z.get_mut(k),
+            self.nx.get_mut(k),
+            self.ny.get_mut(k),
+            self.nz.get_mut(k),
+            self.w.get_mut(k),
+        ) {
+            (*x, *y, *z, *nx, *ny, *nz, *wk) = (p.x, p.y, p.z, n.x, n.y, n.z, w);
+        }
+    }
+
+    fn compute_bounds(&self) -> Ball<T> {
+        let mut c = Vec3::ZERO;
+        let mut count = T::ZERO;
+        for s in self.iter() {
+            c = c + s.point;
+            count += T::ONE;
+        }
+        let center = if count > T::ZERO { c.scale(T::ONE / count) } else { c };
+        let mut radius = T::ZERO;
+        for s in self.iter() {
+            radius = radius.max((s.point - center).norm());
+        }
+        Ball { center, radius }
+    }
+
+    /// Number of samples (order_t · order_s).
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// `true` if there are no samples (never, for a successfully built set).
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// The patch area by eq. (12): Σ w.
+    #[must_use]
+    pub fn area(&self) -> T {
+        self.area
+    }
+
+    /// A ball containing every sample point (used to skip occluders that cannot cut a pair).
+    #[must_use]
+    pub fn bounds(&self) -> Ball<T> {
+        self.bounds
+    }
+
+    /// Sample k, if it exists.
+    #[must_use]
+    pub fn get(&self, k: usize) -> Option<Sample<T>> {
+        if k >= self.len {
+            return None;
+        }
+        Some(Sample {
+            point: vec3(*self.x.get(k)?, *self.y.get(k)?, *self.z.get(k)?),
+            unit_normal: vec3(*self.nx.get(k)?, *self.ny.get(k)?, *self.nz.get(k)?),
+            weight: *self.w.get(k)?,
+        })
+    }
+
+    /// All samples.
+    pub fn iter(&self) -> impl Iterator<Item = Sample<T>> + '_ {
+        (0..self.len).filter_map(move |k| self.get(k))
+    }
+
+    /// The live parts of the structure-of-arrays storage: (x, y, z, nx, ny, nz, w).
+    #[allow(clippy::type_complexity)]
+    pub(crate) fn columns(&self) -> (&[T], &[T], &[T], &[T], &[T], &[T], &[T]) {
+        let n = self.len;
+        (cut(&self.x, n), cut(&self.y, n), cut(&self.z, n), cut(&self.nx, n), cut(&self.ny, n), cut(&self.nz, n), cut(&self.w, n))
+    }
+}
+
+/// One Gauss sample of a patch.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Sample<T> {
+    /// g(t_k, s_k).
+    pub point: Vec3<T>,
+    /// n/|n| (zero where |n| = 0).
+    pub unit_normal: Vec3<T>,
+    /// w_t w_s J |n|: this sample's share of the area.
+    pub weight: T,
+}
+
+#[inline(always)]
+fn cut<T, const CAP: usize>(a: &[T; CAP], n: usize) -> &[T] {
+    a.get(..n).unwrap_or_default()
+}

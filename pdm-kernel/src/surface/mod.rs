@@ -1,0 +1,351 @@
+//! Parametric surfaces g(t, s) → R³ and their unnormalised normals (eqs. 1–4).
+//!
+//! A [`Surface`] gives the point g(t, s) and the normal n(t, s) = ∂g/∂t × ∂g/∂s (eq. 4), whose
+//! length is the area element (eqs. 6–8), over a parameter rectangle ([`ParamRect`]). The normal
+//! points to the side that radiates; a surface that radiates from its other side negates it
+//! ([`Flipped`], or the `inner` constructors of the closed built-ins).
+//!
+//! Two ways to get the normal:
+//! - closed form, written out for every built-in ([`Sphere`], [`Parallelogram`], [`Disk`],
+//!   [`Cylinder`], [`Cone`], [`BezierPatch`]);
+//! - automatically for any [`ParametricMap`], by forward-mode dual numbers: wrap it in
+//!   [`AutoNormal`]. Every built-in is also a `ParametricMap`, and the tests check that both ways
+//!   agree to rounding.
+
+mod bezier;
+mod cone;
+mod cylinder;
+mod disk;
+mod parallelogram;
+mod sphere;
+
+pub use bezier::BezierPatch;
+pub use cone::Cone;
+pub use cylinder::Cylinder;
+pub use disk::Disk;
+pub use parallelogram::Parallelogram;
+pub use sphere::Sphere;
+
+use crate::dual::{Dual, Scalar};
+use crate::error::PdmError;
+use crate::real::Real;
+use crate::vec3::{vec3, Vec3};
+
+/// A parameter rectangle [t0, t1] × [s0, s1].
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ParamRect<T> {
+    /// Start of the t range.
+    pub t0: T,
+    /// End of the t range.
+    pub t1: T,
+    /// Start of the s range.
+    pub s0: T,
+    /// End of the s range.
+    pub s1: T,
+}
+
+impl<T: Real> ParamRect<T> {
+    /// A rectangle, validated: finite bounds and `t0 < t1`, `s0 < s1`.
+    pub fn new(t0: T, t1: T, s0: T, s1: T) -> Result<Self, PdmError> {
+        let r = Self { t0, t1, s0, s1 };
+        r.validate()?;
+        Ok(r)
+    }
+
+    /// `Err(NonFinite)` for a NaN/∞ bound, `Err(EmptyParameterRange)` for an empty interval.
+    pub fn validate(&self) -> Result<(), PdmError> {
+        if !(self.t0.is_finite() && self.t1.is_finite() && self.s0.is_finite() && self.s1.is_finite()) {
+            return Err(PdmError::NonFinite);
+        }
+        if !(self.t0 < self.t1 && self.s0 < self.s1) {
+            return Err(PdmError::EmptyParameterRange);
+        }
+        Ok(())
+    }
+
+    /// `true` if `inner` lies inside `self`, allowing a rounding tolerance relative to the size.
+    #[must_use]
+    pub fn contains(&self, inner: &Self) -> bool {
+        let tol_t = (self.t1 - self.t0).abs() * T::GEOMETRY_TOLERANCE;
+        let tol_s = (self.s1 - self.s0).abs() * T::GEOMETRY_TOLERANCE;
+        inner.t0 >= self.t0 - tol_t
+            && inner.t1 <= self.t1 + tol_t
+            && inner.s0 >= self.s0 - tol_s
+            && inner.s1 <= self.s1 + tol_s
+    }
+
+    /// Cell (i, j) of an m × n grid over this rectangle (i along t, j along s), computed so that
+    /// neighbouring cells share their bounds exactly.
+    #[must_use]
+    pub fn cell(&self, i: usize, j: usize, m: usize, n: usize) -> Self {
+        let at = |k: usize, cnt: usize, a: T, b: T| {
+            if k == 0 {
+                a
+            } else if k >= cnt {
+                b
+            } else {
+                let f = T::from_usize(k) / T::from_usize(cnt);
+                a + (b - a) * f
+            }
+        };
+        Self {
+            t0: at(i, m, self.t0, self.t1),
+            t1: at(i + 1, m, self.t0, self.t1),
+            s0: at(j, n, self.s0, self.s1),
+            s1: at(j + 1, n, self.s0, self.s1),
+        }
+    }
+}
+
+/// A parametric surface g(t, s) with its unnormalised normal n = ∂g/∂t × ∂g/∂s (eq. 4).
+pub trait Surface<T: Real> {
+    /// The parameter rectangle D over which g is defined.
+    fn domain(&self) -> ParamRect<T>;
+    /// The point g(t, s).
+    fn point(&self, t: T, s: T) -> Vec3<T>;
+    /// The normal ±(∂g/∂t × ∂g/∂s) at (t, s), pointing to the radiating side; its length is the
+    /// area element |n| of eq. (8). Zero where the parameterisation degenerates (a sphere's poles).
+    fn normal(&self, t: T, s: T) -> Vec3<T>;
+    /// Point and normal together (override when they share work).
+    #[inline]
+    fn point_and_normal(&self, t: T, s: T) -> (Vec3<T>, Vec3<T>) {
+        (self.point(t, s), self.normal(t, s))
+    }
+}
+
+impl<T: Real, S: Surface<T> + ?Sized> Surface<T> for &S {
+    fn domain(&self) -> ParamRect<T> {
+        (**self).domain()
+    }
+    fn point(&self, t: T, s: T) -> Vec3<T> {
+        (**self).point(t, s)
+    }
+    fn normal(&self, t: T, s: T) -> Vec3<T> {
+        (**self).normal(t, s)
+    }
+    fn point_and_normal(&self, t: T, s: T) -> (Vec3<T>, Vec3<T>) {
+        (**self).point_and_normal(t, s)
+    }
+}
+
+/// A map g(t, s) written once, generically over the arithmetic, so that the kernel can
+/// differentiate it: implement this for your own surface and wrap it in [`AutoNormal`].
+///
+/// ```
+/// use pdm_kernel::{AutoNormal, ParametricMap, ParamRect, Scalar, Surface, Vec3, vec3};
+/// /// A paraboloid cap z = x² + y² over the unit square.
+/// struct Paraboloid;
+/// impl ParametricMap<f64> for Paraboloid {
+///     fn domain(&self) -> ParamRect<f64> { ParamRect { t0: 0.0, t1: 1.0, s0: 0.0, s1: 1.0 } }
+///     fn map<S: Scalar<f64>>(&self, t: S, s: S) -> Vec3<S> { vec3(t, s, t * t + s * s) }
+/// }
+/// let n = AutoNormal(Paraboloid).normal(0.5, 0.25);
+/// // ∂g/∂t × ∂g/∂s = (1,0,2t) × (0,1,2s) = (−2t, −2s, 1)
+/// assert_eq!((n.x, n.y, n.z), (-1.0, -0.5, 1.0));
+/// ```
+pub trait ParametricMap<T: Real> {
+    /// The parameter rectangle D.
+    fn domain(&self) -> ParamRect<T>;
+    /// g(t, s), in any [`Scalar`] arithmetic (plain reals or dual numbers).
+    fn map<S: Scalar<T>>(&self, t: S, s: S) -> Vec3<S>;
+    /// `true` if the surface radiates from the side opposite to ∂g/∂t × ∂g/∂s.
+    fn flipped(&self) -> bool {
+        false
+    }
+}
+
+/// A [`ParametricMap`] whose normal is computed automatically (exact derivatives by dual numbers).
+#[derive(Clone, Copy, Debug)]
+pub struct AutoNormal<M>(pub M);
+
+impl<T: Real, M: ParametricMap<T>> Surface<T> for AutoNormal<M> {
+    fn domain(&self) -> ParamRect<T> {
+        self.0.domain()
+    }
+    fn point(&self, t: T, s: T) -> Vec3<T> {
+        self.0.map(t, s)
+    }
+    fn normal(&self, t: T, s: T) -> Vec3<T> {
+        self.point_and_normal(t, s).1
+    }
+    fn point_and_normal(&self, t: T, s: T) -> (Vec3<T>, Vec3<T>) {
+        let g = self.0.map(Dual::variable_t(t), Dual::variable_s(s));
+        let p = vec3(g.x.v, g.y.v, g.z.v);
+        let gt = vec3(g.x.dt, g.y.dt, g.z.dt);
+        let gs = vec3(g.x.ds, g.y.ds, g.z.ds);
+        let n = gt.cross(gs);
+        (p, if self.0.flipped() { -n } else { n })
+    }
+}
+
+/// Any surface, radiating from its other side (normal negated).
+#[derive(Clone, Copy, Debug)]
+pub struct Flipped<S>(pub S);
+
+impl<T: Real, S: Surface<T>> Surface<T> for Flipped<S> {
+    fn domain(&self) -> ParamRect<T> {
+        self.0.domain()
+    }
+    fn point(&self, t: T, s: T) -> Vec3<T> {
+        self.0.point(t, s)
+    }
+    fn normal(&self, t: T, s: T) -> Vec3<T> {
+        -self.0.normal(t, s)
+    }
+    fn point_and_normal(&self, t: T, s: T) -> (Vec3<T>, Vec3<T>) {
+        let (p, n) = self.0.point_and_normal(t, s);
+        (p, -n)
+    }
+}
+
+/// Which side of a closed built-in (sphere, cylinder, cone) radiates.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Side {
+    /// The convex, outward-facing side.
+    Outer,
+    /// The concave, inward-facing side (a patch on it may see itself: F_ii ≠ 0).
+    Inner,
+}
+
+/// An orthonormal right-handed frame (u, w, axis) with u × w = axis.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Frame<T> {
+    /// First in-plane unit vector (θ = 0 direction).
+    pub u: Vec3<T>,
+    /// Second in-plane unit vector (θ = π/2 direction).
+    pub w: Vec3<T>,
+    /// Unit axis.
+    pub axis: Vec3<T>,
+}
+
+impl<T: Real> Frame<T> {
+    /// A frame around `axis` (normalised here); `Err` for a zero or non-finite axis.
+    /// The in-plane vectors follow Duff et al., "Building an orthonormal basis, revisited" (2017).
+    pub fn from_axis(axis: Vec3<T>) -> Result<Self, PdmError> {
+        if !axis.is_finite() {
+            return Err(PdmError::NonFinite);
+        }
+        let len = axis.norm();
+        if !(len > T::ZERO) {
+            return Err(PdmError::Degenerate);
+        }
+        let n = axis.scale(T::ONE / len);
+        let sign = if n.z >= T::ZERO { T::ONE } else { -T::ONE };
+        let a = -T::ONE / (sign + n.z);
+        let b = n.x * n.y * a;
+        let u = vec3(T::ONE + sign * n.x * n.x * a, sign * b, -sign * n.x);
+        let w = vec3(b, sign + n.y * n.y * a, -n.y);
+        Ok(Self { u, w, axis: n })
+    }
+
+    /// The frame with the z axis as axis: u = x̂, w = ŷ.
+    #[must_use]
+    pub fn standard() -> Self {
+        Self { u: vec3(T::ONE, T::ZERO, T::ZERO), w: vec3(T::ZERO, T::ONE, T::ZERO), axis: vec3(T::ZERO, T::ZERO, T::ONE) }
+    }
+
+    /// u·a + w·b + axis·c for scalar coordinates in any arithmetic.
+    #[inline(always)]
+    pub(crate) fn combine<S: Scalar<T>>(&self, a: S, b: S, c: S) -> Vec3<S> {
+        let k = |v: T| S::constant(v);
+        vec3(
+            k(self.u.x) * a + k(self.w.x) * b + k(self.axis.x) * c,
+            k(self.u.y) * a + k(self.w.y) * b + k(self.axis.y) * c,
+            k(self.u.z) * a + k(self.w.z) * b + k(self.axis.z) * c,
+        )
+    }
+}
+
+/// Lifts a constant point into any arithmetic.
+#[inline(always)]
+pub(crate) fn lift<T: Real, S: Scalar<T>>(p: Vec3<T>) -> Vec3<S> {
+    vec3(S::constant(p.x), S::constant(p.y), S::constant(p.z))
+}
+
+/// `Err(NonFinite)` unless every value is finite.
+pub(crate) fn check_finite<T: Real>(values: &[T]) -> Result<(), PdmError> {
+    if values.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(PdmError::NonFinite)
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod test_support {
+    use super::*;
+
+    /// Checks that a built-in's closed-form normal equals the automatic one (dual numbers) and
+    /// that `point` equals the map, at a grid of interior parameter points.
+    pub(crate) fn closed_form_matches_auto<S>(surface: &S, rel_tol: f64)
+    where
+        S: Surface<f64> + ParametricMap<f64> + Clone,
+    {
+        let d = Surface::domain(surface);
+        let auto = AutoNormal(surface.clone());
+        let mut checked = 0;
+        for i in 0..7 {
+            for j in 0..7 {
+                let t = d.t0 + (d.t1 - d.t0) * (0.05 + 0.15 * i as f64);
+                let s = d.s0 + (d.s1 - d.s0) * (0.03 + 0.155 * j as f64);
+                let (p, n) = surface.point_and_normal(t, s);
+                let (pa, na) = auto.point_and_normal(t, s);
+                let scale = na.norm().max(1e-300);
+                assert!((n - na).norm() <= rel_tol * scale, "normal at ({t},{s}): closed {n:?} vs auto {na:?}");
+                assert!((p - pa).norm() <= rel_tol * (1.0 + p.norm()), "point at ({t},{s})");
+                assert!((surface.normal(t, s) - n).norm() <= rel_tol * scale);
+                assert!((surface.point(t, s) - p).norm() <= rel_tol * (1.0 + p.norm()));
+                checked += 1;
+            }
+        }
+        assert_eq!(checked, 49);
+    }
+
+    /// A second, independent check: n ≈ central finite differences of g.
+    pub(crate) fn normal_matches_finite_differences<S: Surface<f64>>(surface: &S, rel_tol: f64) {
+        let d = surface.domain();
+        let h = 1e-6;
+        for (ft, fs) in [(0.3, 0.4), (0.71, 0.13), (0.5, 0.9)] {
+            let t = d.t0 + (d.t1 - d.t0) * ft;
+            let s = d.s0 + (d.s1 - d.s0) * fs;
+            let gt = (surface.point(t + h, s) - surface.point(t - h, s)).scale(0.5 / h);
+            let gs = (surface.point(t, s + h) - surface.point(t, s - h)).scale(0.5 / h);
+            let fd = gt.cross(gs);
+            let n = surface.normal(t, s);
+            let same = (n - fd).norm() <= rel_tol * n.norm();
+            let opposite = (n + fd).norm() <= rel_tol * n.norm();
+            assert!(same || opposite, "normal {n:?} vs finite difference {fd:?}");
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frame_is_orthonormal_right_handed() {
+        for axis in [vec3(0.0, 0.0, 1.0), vec3(0.0, 0.0, -1.0), vec3(1.0, 2.0, -3.0), vec3(-1e-9, 1e-9, -1.0)] {
+            let f = Frame::<f64>::from_axis(axis).unwrap();
+            assert!((f.u.norm() - 1.0).abs() < 1e-14);
+            assert!((f.w.norm() - 1.0).abs() < 1e-14);
+            assert!(f.u.dot(f.w).abs() < 1e-14);
+            assert!((f.u.cross(f.w) - f.axis).norm() < 1e-14, "{f:?}");
+        }
+        assert_eq!(Frame::<f64>::from_axis(vec3(0.0, 0.0, 0.0)), Err(PdmError::Degenerate));
+        assert_eq!(Frame::<f64>::from_axis(vec3(f64::NAN, 0.0, 1.0)), Err(PdmError::NonFinite));
+    }
+
+    #[test]
+    fn rect_validation_and_cells() {
+        assert_eq!(ParamRect::new(1.0, 1.0, 0.0, 1.0), Err(PdmError::EmptyParameterRange));
+        assert_eq!(ParamRect::new(0.0, f64::INFINITY, 0.0, 1.0), Err(PdmError::NonFinite));
+        let r = ParamRect::new(0.0, 3.0, -1.0, 1.0).unwrap();
+        let c = r.cell(2, 0, 3, 4);
+        assert_eq!((c.t0, c.t1, c.s0, c.s1), (2.0, 3.0, -1.0, -0.5));
+        assert_eq!(r.cell(0, 1, 3, 4).t1, r.cell(1, 1, 3, 4).t0);
+    }
+}

@@ -1,0 +1,151 @@
+//! The sphere of the paper, eqs. (19)–(21).
+
+use super::{check_finite, lift, Frame, ParamRect, ParametricMap, Side, Surface};
+use crate::dual::Scalar;
+use crate::error::PdmError;
+use crate::real::Real;
+use crate::vec3::Vec3;
+
+/// A sphere of centre c and radius r, parameterised as in eq. (19):
+/// g(φ, θ) = c + r (sin φ cos θ · u + sin φ sin θ · w + cos φ · axis), φ ∈ [0, π] (t), θ ∈ [0, 2π] (s).
+///
+/// With the standard frame (axis = z) this is exactly eq. (19); the poles (φ = 0, π) lie on the
+/// axis. The closed-form normal is eq. (21), n = r² sin φ (sin φ cos θ, sin φ sin θ, cos φ),
+/// which points outward and vanishes at the poles (the area element is zero there; the kernel
+/// gives such points zero weight and never divides by |n|).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Sphere<T> {
+    pub(crate) center: Vec3<T>,
+    pub(crate) radius: T,
+    pub(crate) frame: Frame<T>,
+    pub(crate) side: Side,
+}
+
+impl<T: Real> Sphere<T> {
+    /// A sphere with its poles on the z axis (the paper's eq. 19), radiating from `side`.
+    /// `Err` for a non-finite centre or radius, or a radius ≤ 0.
+    pub fn new(center: Vec3<T>, radius: T, side: Side) -> Result<Self, PdmError> {
+        Self::with_frame(center, radius, Frame::standard(), side)
+    }
+
+    /// A sphere whose poles lie on `frame.axis` and whose θ = 0 meridian is in the `frame.u` direction.
+    pub fn with_frame(center: Vec3<T>, radius: T, frame: Frame<T>, side: Side) -> Result<Self, PdmError> {
+        check_finite(&[center.x, center.y, center.z, radius])?;
+        if !(radius > T::ZERO) {
+            return Err(PdmError::Degenerate);
+        }
+        Ok(Self { center, radius, frame, side })
+    }
+
+    /// Radiating from the outside (convex side).
+    pub fn outer(center: Vec3<T>, radius: T) -> Result<Self, PdmError> {
+        Self::new(center, radius, Side::Outer)
+    }
+
+    /// Radiating from the inside (concave side).
+    pub fn inner(center: Vec3<T>, radius: T) -> Result<Self, PdmError> {
+        Self::new(center, radius, Side::Inner)
+    }
+
+    /// Centre.
+    #[must_use]
+    pub fn center(&self) -> Vec3<T> {
+        self.center
+    }
+    /// Radius.
+    #[must_use]
+    pub fn radius(&self) -> T {
+        self.radius
+    }
+    /// Radiating side.
+    #[must_use]
+    pub fn side(&self) -> Side {
+        self.side
+    }
+}
+
+impl<T: Real> ParametricMap<T> for Sphere<T> {
+    fn domain(&self) -> ParamRect<T> {
+        ParamRect { t0: T::ZERO, t1: T::PI, s0: T::ZERO, s1: T::TWO * T::PI }
+    }
+    /// Eq. (19).
+    fn map<S: Scalar<T>>(&self, phi: S, theta: S) -> Vec3<S> {
+        let r = S::constant(self.radius);
+        let sp = phi.sin();
+        let local = self.frame.combine(r * sp * theta.cos(), r * sp * theta.sin(), r * phi.cos());
+        lift::<T, S>(self.center) + local
+    }
+    fn flipped(&self) -> bool {
+        self.side == Side::Inner
+    }
+}
+
+impl<T: Real> Surface<T> for Sphere<T> {
+    fn domain(&self) -> ParamRect<T> {
+        ParametricMap::domain(self)
+    }
+    fn point(&self, t: T, s: T) -> Vec3<T> {
+        self.point_and_normal(t, s).0
+    }
+    fn normal(&self, t: T, s: T) -> Vec3<T> {
+        self.point_and_normal(t, s).1
+    }
+    /// Eq. (19) and eq. (21): n = r² sin φ · (unit radial direction).
+    fn point_and_normal(&self, phi: T, theta: T) -> (Vec3<T>, Vec3<T>) {
+        let (sp, cp) = (phi.sin(), phi.cos());
+        let (st, ct) = (theta.sin(), theta.cos());
+        let radial = self.frame.combine(sp * ct, sp * st, cp);
+        let p = self.center + radial.scale(self.radius);
+        let n = radial.scale(self.radius * self.radius * sp);
+        (p, if self.side == Side::Inner { -n } else { n })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::test_support::*;
+    use super::*;
+    use crate::vec3::vec3;
+
+    #[test]
+    fn normal_is_eq_21() {
+        let s = Sphere::outer(vec3(0.0, 0.0, 0.0), 2.0).unwrap();
+        let (phi, theta) = (0.7_f64, 2.1_f64);
+        let n = s.normal(phi, theta);
+        let r2 = 4.0;
+        let expect = vec3(
+            r2 * phi.sin().powi(2) * theta.cos(),
+            r2 * phi.sin().powi(2) * theta.sin(),
+            r2 * phi.cos() * phi.sin(),
+        );
+        assert!((n - expect).norm() < 1e-14);
+        assert_eq!(s.normal(0.0, 1.0).norm(), 0.0, "pole has zero area element");
+    }
+
+    #[test]
+    fn closed_form_agrees_with_dual_numbers() {
+        let frame = Frame::from_axis(vec3(1.0, -2.0, 0.5)).unwrap();
+        for side in [Side::Outer, Side::Inner] {
+            closed_form_matches_auto(&Sphere::with_frame(vec3(1.0, 2.0, 3.0), 1.5, frame, side).unwrap(), 1e-14);
+            normal_matches_finite_differences(&Sphere::with_frame(vec3(1.0, 2.0, 3.0), 1.5, frame, side).unwrap(), 1e-8);
+        }
+    }
+
+    #[test]
+    fn sides_point_out_and_in() {
+        let out = Sphere::outer(vec3(0.0, 0.0, 0.0), 1.0).unwrap();
+        let inn = Sphere::inner(vec3(0.0, 0.0, 0.0), 1.0).unwrap();
+        let (p, n) = out.point_and_normal(1.0, 1.0);
+        assert!(p.dot(n) > 0.0);
+        assert!(p.dot(inn.normal(1.0, 1.0)) < 0.0);
+    }
+
+    #[test]
+    fn bad_input() {
+        assert_eq!(Sphere::outer(vec3(0.0, 0.0, 0.0), 0.0), Err(PdmError::Degenerate));
+        assert_eq!(Sphere::outer(vec3(0.0, f64::NAN, 0.0), 1.0), Err(PdmError::NonFinite));
+        assert_eq!(Sphere::outer(vec3(0.0, 0.0, 0.0), f64::INFINITY), Err(PdmError::NonFinite));
+        assert_eq!(Sphere::outer(vec3(0.0_f32, 0.0, 0.0), -1.0), Err(PdmError::Degenerate));
+    }
+}
