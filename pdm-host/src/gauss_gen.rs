@@ -39,7 +39,7 @@
 //! test); otherwise generation fails with [`GenError::AmbiguousRounding`] instead of guessing.
 
 use std::fmt::{self, Write as _};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use dashu_int::ops::{BitTest, UnsignedAbs};
 use dashu_int::{IBig, UBig};
@@ -164,7 +164,11 @@ pub fn fixed_from_f64(x: f64, bits: usize) -> Option<IBig> {
     let raw = x.to_bits();
     let biased = i64::try_from((raw >> 52) & 0x7ff).ok()?;
     let frac = raw & ((1_u64 << 52) - 1);
-    let (mant, exp) = if biased == 0 { (frac, -1074) } else { (frac | (1_u64 << 52), biased - 1075) };
+    let (mant, exp) = if biased == 0 {
+        (frac, -1074)
+    } else {
+        (frac | (1_u64 << 52), biased - 1075)
+    };
     let mag = IBig::from(mant);
     let shift = exp + i64::try_from(bits).ok()?;
     let value = if shift >= 0 {
@@ -257,8 +261,8 @@ pub fn hp_rule_with_bits(n: usize, bits: usize) -> Result<HpRule, GenError> {
     let mut positive: Vec<IBig> = Vec::with_capacity(n / 2);
     for root in 0..n / 2 {
         let guess = f64_guess(n, root);
-        let mut x = fixed_from_f64(guess, bits)
-            .ok_or(GenError::NoConvergence { order: n, root })?;
+        let mut x =
+            fixed_from_f64(guess, bits).ok_or(GenError::NoConvergence { order: n, root })?;
         let mut converged = false;
         for _ in 0..16 {
             let dx = newton_step(n, &x, bits).ok_or(GenError::NoConvergence { order: n, root })?;
@@ -323,7 +327,11 @@ pub fn hp_rule_with_bits(n: usize, bits: usize) -> Result<HpRule, GenError> {
         .cloned()
         .chain(half_weights.iter().rev().cloned())
         .collect();
-    Ok(HpRule { frac_bits: bits, nodes, weights })
+    Ok(HpRule {
+        frac_bits: bits,
+        nodes,
+        weights,
+    })
 }
 
 /// The n-point rule at the default precision [`FRAC_BITS`].
@@ -350,7 +358,11 @@ fn round_significand(raw: &IBig, bits: usize, precision: usize) -> Option<(bool,
     let shift = len - precision;
     let (low, high) = mag.split_bits(shift);
     let half = UBig::ONE << (shift - 1);
-    let dist = if low > half { &low - &half } else { &half - &low };
+    let dist = if low > half {
+        &low - &half
+    } else {
+        &half - &low
+    };
     if dist <= (UBig::ONE << ERROR_BOUND_BITS) {
         return None; // Ziv: cannot decide the rounding direction with certainty
     }
@@ -379,7 +391,9 @@ pub fn round_to_f64(raw: &IBig, bits: usize) -> Option<f64> {
         return None;
     }
     let sign = if negative { 1_u64 << 63 } else { 0 };
-    Some(f64::from_bits(sign | (biased << 52) | (q & ((1_u64 << 52) - 1))))
+    Some(f64::from_bits(
+        sign | (biased << 52) | (q & ((1_u64 << 52) - 1)),
+    ))
 }
 
 /// `raw · 2^−bits` correctly rounded (to nearest, ties to even) **directly** to f32; `None` if
@@ -396,7 +410,9 @@ pub fn round_to_f32(raw: &IBig, bits: usize) -> Option<f32> {
     }
     let q = u32::try_from(q).ok()?;
     let sign = if negative { 1_u32 << 31 } else { 0 };
-    Some(f32::from_bits(sign | (biased << 23) | (q & ((1_u32 << 23) - 1))))
+    Some(f32::from_bits(
+        sign | (biased << 23) | (q & ((1_u32 << 23) - 1)),
+    ))
 }
 
 /// The rounded tables for orders 1..=[`MAX_ORDER`].
@@ -415,11 +431,19 @@ pub fn tables() -> Result<Tables, GenError> {
         let rule = hp_rule(n)?;
         let bits = rule.frac_bits;
         for (index, (x, w)) in rule.nodes.iter().zip(&rule.weights).enumerate() {
-            let err = |what| GenError::AmbiguousRounding { order: n, index, what };
-            t.nodes_f64.push(round_to_f64(x, bits).ok_or_else(|| err("node (f64)"))?);
-            t.weights_f64.push(round_to_f64(w, bits).ok_or_else(|| err("weight (f64)"))?);
-            t.nodes_f32.push(round_to_f32(x, bits).ok_or_else(|| err("node (f32)"))?);
-            t.weights_f32.push(round_to_f32(w, bits).ok_or_else(|| err("weight (f32)"))?);
+            let err = |what| GenError::AmbiguousRounding {
+                order: n,
+                index,
+                what,
+            };
+            t.nodes_f64
+                .push(round_to_f64(x, bits).ok_or_else(|| err("node (f64)"))?);
+            t.weights_f64
+                .push(round_to_f64(w, bits).ok_or_else(|| err("weight (f64)"))?);
+            t.nodes_f32
+                .push(round_to_f32(x, bits).ok_or_else(|| err("node (f32)"))?);
+            t.weights_f32
+                .push(round_to_f32(w, bits).ok_or_else(|| err("weight (f32)"))?);
         }
         t.offsets.push(t.nodes_f64.len());
     }
@@ -432,7 +456,10 @@ pub fn render(t: &Tables) -> String {
     let mut s = String::with_capacity(4 * 40 * TABLE_LEN + 512);
     // Writing to a String cannot fail.
     let _ = writeln!(s, "{HEADER}");
-    let _ = writeln!(s, "#![allow(clippy::unreadable_literal, clippy::excessive_precision)]");
+    let _ = writeln!(
+        s,
+        "#![allow(clippy::unreadable_literal, clippy::excessive_precision)]"
+    );
     let _ = writeln!(s, "pub(crate) const MAX_ORDER: usize = {MAX_ORDER};");
     let offsets: Vec<String> = t.offsets.iter().map(ToString::to_string).collect();
     let _ = writeln!(
@@ -441,22 +468,38 @@ pub fn render(t: &Tables) -> String {
         t.offsets.len(),
         offsets.join(", ")
     );
-    let _ = writeln!(s, "pub(crate) static NODES_F64: [f64; {}] = [", t.nodes_f64.len());
+    let _ = writeln!(
+        s,
+        "pub(crate) static NODES_F64: [f64; {}] = [",
+        t.nodes_f64.len()
+    );
     for v in &t.nodes_f64 {
         let _ = writeln!(s, "    f64::from_bits(0x{:016x}),", v.to_bits());
     }
     let _ = writeln!(s, "];");
-    let _ = writeln!(s, "pub(crate) static WEIGHTS_F64: [f64; {}] = [", t.weights_f64.len());
+    let _ = writeln!(
+        s,
+        "pub(crate) static WEIGHTS_F64: [f64; {}] = [",
+        t.weights_f64.len()
+    );
     for v in &t.weights_f64 {
         let _ = writeln!(s, "    f64::from_bits(0x{:016x}),", v.to_bits());
     }
     let _ = writeln!(s, "];");
-    let _ = writeln!(s, "pub(crate) static NODES_F32: [f32; {}] = [", t.nodes_f32.len());
+    let _ = writeln!(
+        s,
+        "pub(crate) static NODES_F32: [f32; {}] = [",
+        t.nodes_f32.len()
+    );
     for v in &t.nodes_f32 {
         let _ = writeln!(s, "    f32::from_bits(0x{:08x}),", v.to_bits());
     }
     let _ = writeln!(s, "];");
-    let _ = writeln!(s, "pub(crate) static WEIGHTS_F32: [f32; {}] = [", t.weights_f32.len());
+    let _ = writeln!(
+        s,
+        "pub(crate) static WEIGHTS_F32: [f32; {}] = [",
+        t.weights_f32.len()
+    );
     for v in &t.weights_f32 {
         let _ = writeln!(s, "    f32::from_bits(0x{:08x}),", v.to_bits());
     }
@@ -475,8 +518,9 @@ pub fn render_tables() -> Result<String, GenError> {
 /// Path of the generated file in this workspace.
 #[must_use]
 pub fn tables_path() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("..")
+    let host = Path::new(env!("CARGO_MANIFEST_DIR"));
+    host.parent()
+        .map_or_else(|| host.join(".."), Path::to_path_buf)
         .join("pdm-kernel")
         .join("src")
         .join("gauss")

@@ -50,8 +50,9 @@ impl<T: Real, const CAP: usize> PatchSamples<T, CAP> {
     /// Samples `patch` with `order_t` points along t and `order_s` along s.
     ///
     /// Errors: `UnsupportedOrder`; `CapacityExceeded` if `order_t·order_s > CAP`; `NonFinite` if
-    /// the surface evaluates to NaN/∞; `Degenerate` if the patch area is zero (or below
-    /// (2¹²ε)² of its squared extent) or not finite.
+    /// the surface evaluates to NaN/∞; `Degenerate` if the patch area is zero, below
+    /// `GEOMETRY_TOLERANCE²` times its squared extent, or its extent is below
+    /// `GEOMETRY_TOLERANCE` times its distance from the origin (a point, up to rounding).
     pub fn with_orders<S: Surface<T> + ?Sized>(
         patch: &Patch<'_, T, S>,
         order_t: usize,
@@ -104,9 +105,11 @@ impl<T: Real, const CAP: usize> PatchSamples<T, CAP> {
         }
         out.area = area;
         out.bounds = out.compute_bounds();
-        let extent = out.bounds.radius * T::TWO;
+        let (extent, magnitude) = patch_extent(patch);
         let tiny = T::GEOMETRY_TOLERANCE * T::GEOMETRY_TOLERANCE * extent * extent;
-        if !(area > T::ZERO) || !(area > tiny) || !out.bounds.radius.is_finite() {
+        // A patch whose extent is lost in the rounding of its coordinates is a point.
+        let lost_in_rounding = extent <= T::GEOMETRY_TOLERANCE * magnitude;
+        if !(area > T::ZERO) || !(area > tiny) || !extent.is_finite() || lost_in_rounding {
             return Err(PdmError::Degenerate);
         }
         Ok(out)
@@ -206,4 +209,25 @@ pub struct Sample<T> {
 #[inline(always)]
 fn cut<T, const CAP: usize>(a: &[T; CAP], n: usize) -> &[T] {
     a.get(..n).unwrap_or_default()
+}
+
+/// (Largest distance of the patch's 3 × 3 grid of corner, edge-midpoint and centre points from
+/// its centre point, largest coordinate magnitude among them): a cheap size estimate used only
+/// to recognise degenerate patches.
+fn patch_extent<T: Real, S: Surface<T> + ?Sized>(patch: &Patch<'_, T, S>) -> (T, T) {
+    let r = patch.rect();
+    let surface = patch.surface();
+    let mid_t = (r.t0 + r.t1) * T::HALF;
+    let mid_s = (r.s0 + r.s1) * T::HALF;
+    let center = surface.point(mid_t, mid_s);
+    let mut extent = T::ZERO;
+    let mut magnitude = center.max_abs();
+    for t in [r.t0, mid_t, r.t1] {
+        for s in [r.s0, mid_s, r.s1] {
+            let p = surface.point(t, s);
+            extent = extent.max((p - center).norm());
+            magnitude = magnitude.max(p.max_abs());
+        }
+    }
+    (extent, magnitude)
 }
