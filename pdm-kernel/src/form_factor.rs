@@ -133,7 +133,7 @@ where
     O: Occluder<T> + ?Sized,
 {
     let a = PatchSamples::<T, CAP>::new(patch, order)?;
-    let b = PatchSamples::<T, CAP>::new(patch, order + 1)?;
+    let b = PatchSamples::<T, CAP>::new(patch, order.saturating_add(1))?;
     // Use the order-(p+1) area for the normalisation of the symmetric exchange: both copies
     // estimate the same area; take the mean to keep reciprocity exact.
     let e = exchange(&a, &b, occluders)?;

@@ -26,7 +26,16 @@
 
 #![no_std]
 #![forbid(unsafe_code)]
-#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, missing_docs)]
+#![deny(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    clippy::indexing_slicing,
+    clippy::unreachable,
+    clippy::todo,
+    clippy::unimplemented,
+    missing_docs
+)]
 #![cfg_attr(test, allow(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing))]
 
 pub mod dual;
@@ -37,6 +46,7 @@ mod math;
 pub mod patch;
 pub mod real;
 pub mod samples;
+pub mod singular;
 pub mod surface;
 pub mod vec3;
 pub mod visibility;
@@ -48,6 +58,7 @@ pub use gauss::{GaussRule, MAX_ORDER};
 pub use patch::{Patch, PatchGrid};
 pub use real::Real;
 pub use samples::{Ball, PatchSamples, Sample};
+pub use singular::{classify, touching_exchange, Adjacency, SquareMap};
 pub use surface::{
     AutoNormal, BezierPatch, Cone, Cylinder, Disk, Flipped, Frame, ParamRect, Parallelogram, ParametricMap, Side,
     Sphere, Surface,

@@ -118,6 +118,10 @@ impl<'s, T: Real, S: Surface<T> + ?Sized> PatchGrid<'s, T, S> {
         if m == 0 || n == 0 {
             return Err(PdmError::EmptyParameterRange);
         }
+        // m·n must be countable (the iterator indexes cells by k < m·n).
+        if m.checked_mul(n).is_none() {
+            return Err(PdmError::CapacityExceeded { needed: usize::MAX, capacity: usize::MAX });
+        }
         rect.validate()?;
         if !surface.domain().contains(&rect) {
             return Err(PdmError::OutsideDomain);
@@ -134,7 +138,7 @@ impl<'s, T: Real, S: Surface<T> + ?Sized> PatchGrid<'s, T, S> {
     /// Number of patches, m·n.
     #[must_use]
     pub fn count(&self) -> usize {
-        self.m * self.n
+        self.m.saturating_mul(self.n)
     }
 
     /// Patch (i, j): i-th along t, j-th along s; `None` outside the grid.
@@ -150,7 +154,7 @@ impl<'s, T: Real, S: Surface<T> + ?Sized> PatchGrid<'s, T, S> {
 impl<'s, T: Real, S: Surface<T> + ?Sized> Iterator for PatchGrid<'s, T, S> {
     type Item = Patch<'s, T, S>;
     fn next(&mut self) -> Option<Self::Item> {
-        if self.next >= self.m * self.n {
+        if self.next >= self.m.saturating_mul(self.n) {
             return None;
         }
         let k = self.next;
@@ -158,7 +162,7 @@ impl<'s, T: Real, S: Surface<T> + ?Sized> Iterator for PatchGrid<'s, T, S> {
         self.cell(k / self.n, k % self.n)
     }
     fn size_hint(&self) -> (usize, Option<usize>) {
-        let left = (self.m * self.n).saturating_sub(self.next);
+        let left = (self.m.saturating_mul(self.n)).saturating_sub(self.next);
         (left, Some(left))
     }
 }

@@ -65,6 +65,12 @@ fn distance_point_segment<T: Real>(c: Vec3<T>, a: Vec3<T>, b: Vec3<T>) -> T {
     (c - (a + d.scale(tau))).norm()
 }
 
+/// `true` if the signed offset n·(o − x) of point x from the plane through o is zero up to rounding.
+#[inline(always)]
+fn on_plane<T: Real>(offset: T, n: Vec3<T>, x: Vec3<T>, o: Vec3<T>) -> bool {
+    offset.abs() <= T::from_f64(64.0) * T::EPSILON * n.norm() * (x.max_abs() + o.max_abs() + (x - o).max_abs())
+}
+
 /// `true` if τ lies strictly inside (tol, 1 − tol).
 #[inline(always)]
 fn interior<T: Real>(tau: T) -> bool {
@@ -88,22 +94,55 @@ fn quadratic_roots<T: Real>(a: T, b: T, c: T) -> Option<(T, T)> {
 }
 
 impl<T: Real> Occluder<T> for Sphere<T> {
-    /// Segment–sphere: roots of |p + τ(q − p) − c|² = R².
+    /// Segment–sphere: roots of |p + τ(q − p) − c|² = R², i.e. τ² a + 2τ b + c₀ = 0.
     fn blocks(&self, p: Vec3<T>, q: Vec3<T>) -> bool {
         let d = q - p;
         let f = p - self.center;
-        // Scale-free: divide through by |d|² so the coefficients are O(1) relative numbers.
-        let a = d.norm2();
-        let b = f.dot(d);
-        let c = f.norm2() - self.radius * self.radius;
-        match quadratic_roots(a, b, c) {
-            Some((t1, t2)) => interior(t1) || interior(t2),
-            None => false,
-        }
+        let r2 = self.radius * self.radius;
+        crossing_of_quadric(d.norm2(), f.dot(d), f.norm2() - r2, (q - self.center).norm2() - r2, r2, |_| true)
     }
     fn may_block_between(&self, a: &Ball<T>, b: &Ball<T>) -> bool {
         ball_may_cut_pair(self.center, self.radius, a, b)
     }
+}
+
+/// Whether the segment crosses a quadric surface f(τ) = a τ² + 2 b τ + c_p with f(1) = c_q,
+/// at an interior τ accepted by `accept`. An end point lying on the surface (|c| within
+/// rounding, [`on_surface`]) is a root τ = 0 or 1 *exactly*: the other root then follows from
+/// Vieta's formulas, so rounding in c never creates a spurious crossing next to an end point
+/// (which for short chords in f32 would otherwise exceed any fixed τ tolerance).
+#[inline]
+fn crossing_of_quadric<T: Real>(a: T, b: T, c_p: T, c_q: T, scale: T, accept: impl Fn(T) -> bool) -> bool {
+    if !(a > T::ZERO) {
+        return false;
+    }
+    let p_on = on_surface(c_p, scale);
+    let q_on = on_surface(c_q, scale);
+    match (p_on, q_on) {
+        // A chord between two points of the surface: it meets the surface only at its ends.
+        (true, true) => false,
+        // Roots 0 and −2b/a.
+        (true, false) => {
+            let t = -T::TWO * b / a;
+            interior(t) && accept(t)
+        }
+        // Roots 1 and c_p/a (product of the roots).
+        (false, true) => {
+            let t = c_p / a;
+            interior(t) && accept(t)
+        }
+        (false, false) => match quadratic_roots(a, b, c_p) {
+            Some((t1, t2)) => (interior(t1) && accept(t1)) || (interior(t2) && accept(t2)),
+            None => false,
+        },
+    }
+}
+
+/// `true` if a quadric's value `c` at a point is zero up to the rounding of evaluating it at
+/// that scale (`scale` ≈ R²): the point lies on the surface.
+#[inline(always)]
+fn on_surface<T: Real>(c: T, scale: T) -> bool {
+    c.abs() <= T::from_f64(64.0) * T::EPSILON * scale
 }
 
 impl<T: Real> Occluder<T> for Parallelogram<T> {
@@ -115,7 +154,12 @@ impl<T: Real> Occluder<T> for Parallelogram<T> {
         if denom == T::ZERO {
             return false;
         }
-        let tau = n.dot(self.origin - p) / denom;
+        let offset = n.dot(self.origin - p);
+        let far_end = n.dot(self.origin - q);
+        if on_plane(offset, n, p, self.origin) || on_plane(far_end, n, q, self.origin) {
+            return false; // a segment from a point of the plane meets it only there
+        }
+        let tau = offset / denom;
         if !interior(tau) {
             return false;
         }
@@ -141,7 +185,11 @@ impl<T: Real> Occluder<T> for Disk<T> {
         if denom == T::ZERO {
             return false;
         }
-        let tau = n.dot(self.center - p) / denom;
+        let offset = n.dot(self.center - p);
+        if on_plane(offset, n, p, self.center) || on_plane(n.dot(self.center - q), n, q, self.center) {
+            return false; // a segment from a point of the plane meets it only there
+        }
+        let tau = offset / denom;
         if !interior(tau) {
             return false;
         }
@@ -164,17 +212,14 @@ impl<T: Real> Occluder<T> for Cylinder<T> {
         let d_ax = d.dot(axis);
         let f_perp = f - axis.scale(f_ax);
         let d_perp = d - axis.scale(d_ax);
-        let a = d_perp.norm2();
-        let b = f_perp.dot(d_perp);
-        let c = f_perp.norm2() - self.radius * self.radius;
+        let r2 = self.radius * self.radius;
+        let g = q - self.base;
+        let g_perp = g - axis.scale(g.dot(axis));
         let in_height = |tau: T| {
             let z = f_ax + tau * d_ax;
             z >= T::ZERO && z <= self.height
         };
-        match quadratic_roots(a, b, c) {
-            Some((t1, t2)) => (interior(t1) && in_height(t1)) || (interior(t2) && in_height(t2)),
-            None => false,
-        }
+        crossing_of_quadric(d_perp.norm2(), f_perp.dot(d_perp), f_perp.norm2() - r2, g_perp.norm2() - r2, r2, in_height)
     }
     fn may_block_between(&self, a: &Ball<T>, b: &Ball<T>) -> bool {
         let center = self.base + self.frame.axis.scale(self.height * T::HALF);

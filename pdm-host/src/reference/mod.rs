@@ -1,2 +1,17 @@
 //! Independent reference values: closed forms from the configuration-factor catalogue and
 //! computations that share no code with the kernel's quadrature.
+//!
+//! Nothing here uses `pdm_kernel`: plain `f64`, own vector helpers ([`vector`]) and own
+//! quadrature rules ([`quadrature`], Gauss–Legendre nodes by Newton iteration).
+//! * [`closed_form`]: catalogue entries C-11, C-14, C-41, sphere identities.
+//! * [`contour`]: planar polygon → planar polygon by the contour (Stokes) form.
+//! * [`monte_carlo`]: seeded, multithreaded ray estimator for the paper's cube-and-sphere scene.
+//! * [`cube`]: deterministic high-accuracy face → face factors of that scene with the sphere as
+//!   occluder (visibility boundaries put into the rule).
+
+pub mod closed_form;
+pub mod contour;
+pub mod cube;
+pub mod monte_carlo;
+pub mod quadrature;
+pub mod vector;

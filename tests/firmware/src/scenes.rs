@@ -1,0 +1,66 @@
+//! The three f32 scenes the firmware computes. This one file is compiled twice: into the
+//! firmware (Cortex-M4F, the kernel with the firmware's features) and into the build script
+//! (the build machine, the kernel with host libm), which embeds its results as the expected
+//! values. Only `core` and the kernel are used here.
+
+use pdm_kernel::{
+    form_factor_between, surface_form_factor, vec3, Parallelogram, Patch, PatchGrid, PdmError, Quadrature, Sphere,
+};
+
+/// Gauss order per axis on each patch (the paper's 5).
+pub const ORDER: usize = 5;
+/// Sample-buffer capacity: ORDER².
+pub const CAP: usize = ORDER * ORDER;
+
+/// Number of scenes.
+pub const COUNT: usize = 3;
+/// Scene names, in the order of [`run`]'s index.
+pub const NAMES: [&str; COUNT] = ["sphere_to_face", "shared_edge", "occluded_pair"];
+
+/// The paper's scene: unit sphere at the origin, cube of side 6; sphere → floor face (z = −3,
+/// facing +z), the sphere as its own occluder, grids 4 × 8 (sphere) and 3 × 3 (face). ≈ 1/6.
+#[inline(never)]
+pub fn sphere_to_face() -> Result<f32, PdmError> {
+    let sphere = Sphere::outer(vec3(0.0_f32, 0.0, 0.0), 1.0)?;
+    let floor = Parallelogram::new(vec3(-3.0_f32, -3.0, -3.0), vec3(6.0, 0.0, 0.0), vec3(0.0, 6.0, 0.0))?;
+    surface_form_factor::<f32, _, _, _, CAP>(
+        PatchGrid::new(&sphere, 4, 8)?,
+        PatchGrid::new(&floor, 3, 3)?,
+        Quadrature::uniform(ORDER),
+        &sphere,
+    )
+}
+
+/// Two perpendicular unit squares sharing the edge [0,1]×{0}×{0}: the floor (normal +z) and the
+/// wall in the plane y = 0 (normal (0,0,1)×(1,0,0) = +y), facing each other. Exact 0.2000438;
+/// the plain Gauss rule overestimates it at a shared edge (the integrand is singular there).
+#[inline(never)]
+pub fn shared_edge() -> Result<f32, PdmError> {
+    let floor = Parallelogram::new(vec3(0.0_f32, 0.0, 0.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0))?;
+    let wall = Parallelogram::new(vec3(0.0_f32, 0.0, 0.0), vec3(0.0, 0.0, 1.0), vec3(1.0, 0.0, 0.0))?;
+    form_factor_between::<f32, _, _, _, CAP>(&Patch::whole(&floor)?, &Patch::whole(&wall)?, Quadrature::uniform(ORDER), &())
+}
+
+/// Two parallel unit squares at distance 1 facing each other (0.1998 unoccluded), with a
+/// 0.5 × 0.5 square occluder centred between them in the plane z = 0.5.
+#[inline(never)]
+pub fn occluded_pair() -> Result<f32, PdmError> {
+    let lower = Parallelogram::new(vec3(0.0_f32, 0.0, 0.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0))?;
+    let upper = Parallelogram::new(vec3(0.0_f32, 0.0, 1.0), vec3(0.0, 1.0, 0.0), vec3(1.0, 0.0, 0.0))?;
+    let blocker = Parallelogram::new(vec3(0.25_f32, 0.25, 0.5), vec3(0.5, 0.0, 0.0), vec3(0.0, 0.5, 0.0))?;
+    form_factor_between::<f32, _, _, _, CAP>(
+        &Patch::whole(&lower)?,
+        &Patch::whole(&upper)?,
+        Quadrature::uniform(ORDER),
+        &blocker,
+    )
+}
+
+/// Scene `i` (0..COUNT).
+pub fn run(i: usize) -> Result<f32, PdmError> {
+    match i {
+        0 => sphere_to_face(),
+        1 => shared_edge(),
+        _ => occluded_pair(),
+    }
+}
