@@ -38,11 +38,13 @@
 )]
 #![cfg_attr(test, allow(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing))]
 
+pub mod boundary;
 pub mod dual;
 pub mod error;
 pub mod form_factor;
 pub mod gauss;
 mod math;
+pub mod pair;
 pub mod patch;
 pub mod real;
 pub mod samples;
@@ -55,6 +57,8 @@ pub use dual::{Dual, Scalar};
 pub use error::PdmError;
 pub use form_factor::{exchange, form_factor, form_factor_between, self_form_factor, surface_form_factor, Quadrature};
 pub use gauss::{GaussRule, MAX_ORDER};
+pub use boundary::boundary_exchange;
+pub use pair::{pair_exchange, PairSettings};
 pub use patch::{Patch, PatchGrid};
 pub use real::Real;
 pub use samples::{Ball, PatchSamples, Sample};

@@ -2,14 +2,7 @@
 //! kernel compiled for the host (host libm), writes them to `$OUT_DIR/expected.rs`, and passes
 //! the linker scripts (`link.x` of cortex-m-rt, `defmt.x` with the `defmt` feature).
 
-// The kernel as built for the build machine, under the name scenes.rs uses (the dependency is
-// renamed in Cargo.toml so the firmware's kernel features do not apply to it).
-extern crate pdm_kernel_host as pdm_kernel;
-
-#[path = "src/scenes.rs"]
-#[allow(dead_code)]
-mod scenes;
-
+use pdm_firmware_scenes as scenes;
 use std::fmt::Write as _;
 
 fn main() {
@@ -29,7 +22,6 @@ fn main() {
     let root = std::env::var("CARGO_MANIFEST_DIR").expect("CARGO_MANIFEST_DIR");
     println!("cargo:rustc-link-search={root}");
     println!("cargo:rerun-if-changed=memory.x");
-    println!("cargo:rerun-if-changed=src/scenes.rs");
     println!("cargo:rerun-if-changed=build.rs");
     if std::env::var("TARGET").map(|t| t.starts_with("thumb")).unwrap_or(false) {
         println!("cargo:rustc-link-arg-bins=-Tlink.x");

@@ -1,7 +1,7 @@
 //! pdm-kernel on a Cortex-M4F (thumbv7em-none-eabihf), run under
 //! `qemu-system-arm -machine mps2-an386 -cpu cortex-m4` with semihosting.
 //!
-//! Computes three f32 scenes (src/scenes.rs: the paper's sphere → face factor on a coarse grid,
+//! Computes three f32 scenes (scenes/src/lib.rs: the paper's sphere → face factor on a coarse grid,
 //! a shared-edge pair, a pair with an occluder), compares each with the value the build machine
 //! computed for the same input (embedded by build.rs), measures the peak stack of each
 //! form-factor call by stack painting, prints everything and exits with status 0 only if every
@@ -17,8 +17,7 @@
 #![no_std]
 #![no_main]
 
-#[cfg_attr(feature = "baseline", allow(dead_code))]
-mod scenes;
+use pdm_firmware_scenes as scenes;
 
 use core::hint::black_box;
 
@@ -36,24 +35,32 @@ mod expected {
 /// The math backend this build uses.
 const BACKEND: &str = if cfg!(feature = "micromath") { "micromath" } else { "libm" };
 
-/// Tolerance per scene, in units in the last place (ulp) of f32 between the firmware's value
-/// and the host's (both positive, so the ulp distance is the difference of the bit patterns).
-///
-/// libm: the same IEEE-754 f32 operations in the same order on both machines (no FMA
-/// contraction, libm's functions are pure Rust and correctly rounded for sqrt), so the values are
-/// expected to be bit-identical; 4 ulp (≈ 5e-7 relative) allows for a libm routine that rounds
-/// differently on another host architecture.
-///
-/// micromath vs host libm: micromath's sin/cos/sqrt approximations move the sphere's sample
-/// points and normals; the measured differences (BUDGETS.md) are 0 ulp for the two
-/// parallelogram scenes (their sample points use no elementary function and the unit normals
-/// of axis-aligned squares are exact) and ~2e-4 relative for the sphere. Tolerance: about 4×
-/// the measured difference.
-const TOLERANCE_ULP: [u32; scenes::COUNT] = if cfg!(feature = "micromath") {
-    [4096, 64, 64]
-} else {
-    [4, 4, 4]
-};
+/// Tolerance per scene of the libm build, in units in the last place (ulp) of f32 between the
+/// firmware's value and the host's (both positive: the ulp distance is the difference of the
+/// bit patterns). The same IEEE-754 f32 operations run in the same order on both machines (no
+/// FMA contraction; libm's functions are plain Rust, sqrt correctly rounded), so the values are
+/// expected to be bit-identical (measured: 0 ulp in every scene); 4 ulp (≈ 5e-7 relative)
+/// leaves room for a libm routine that rounds differently on another host architecture.
+const TOL_ULP_LIBM: [u32; scenes::COUNT] = [4, 4, 4];
+
+/// Relative tolerance per scene of the micromath build against the host's libm value: the
+/// accuracy cost of the backend, measured (BUDGETS.md). The two parallelogram scenes use no
+/// elementary function whose micromath value differs (their sample points are affine and the
+/// unit normals of unit squares are exact even with micromath's sqrt): measured 0, tolerance
+/// 1e-6. The sphere scene: measured −13.5 % (micromath's sqrt is a bit trick with ~5 % error,
+/// and sample points that its sin/cos put ~1e-3 inside the sphere are occluded by the sphere
+/// itself); tolerance 15 %. That the micromath firmware computes exactly what the host computes
+/// with micromath is checked separately by run.sh (bit patterns, ≤ 4 ulp).
+const TOL_REL_MICROMATH: [f32; scenes::COUNT] = [0.15, 1e-6, 1e-6];
+
+/// Whether `value` is within the stated tolerance of scene `i`'s host value.
+fn within_tolerance(i: usize, value: f32, expected: f32) -> bool {
+    if cfg!(feature = "micromath") {
+        ((value - expected) / expected).abs() <= TOL_REL_MICROMATH[i]
+    } else {
+        ulp_distance(value, expected) <= TOL_ULP_LIBM[i]
+    }
+}
 
 /// Pattern written below the stack pointer before a call; the lowest word that no longer holds
 /// it marks the deepest stack use.
@@ -142,10 +149,7 @@ fn main() -> ! {
         let stack = sp_call - lowest_touched(bottom, sp_call);
         let expected = f32::from_bits(expected::EXPECTED_BITS[i]);
         let (ulps, ok) = match value {
-            Ok(v) if v.is_finite() => {
-                let d = ulp_distance(v, expected);
-                (d, d <= TOLERANCE_ULP[i])
-            }
+            Ok(v) if v.is_finite() => (ulp_distance(v, expected), within_tolerance(i, v, expected)),
             _ => (u32::MAX, false),
         };
         all_ok &= ok;
@@ -176,19 +180,34 @@ fn log_outcome(i: usize, o: &Outcome) {
     let name = scenes::NAMES[i];
     match o.value {
         Ok(v) => cortex_m_semihosting::hprintln!(
-            "CASE {} value={:e} bits=0x{:08x} host={:e} host_bits=0x{:08x} diff_ulp={} tol_ulp={} rel={:e} stack={} {}",
+            "CASE {} value={:e} bits=0x{:08x} host={:e} host_bits=0x{:08x} diff_ulp={} rel={:e} tolerance={} stack={} {}",
             name,
             v,
             v.to_bits(),
             o.expected,
             o.expected.to_bits(),
             o.ulps,
-            TOLERANCE_ULP[i],
             (v - o.expected) / o.expected,
+            Tolerance(i),
             o.stack,
             if o.ok { "ok" } else { "MISMATCH" }
         ),
         Err(e) => cortex_m_semihosting::hprintln!("CASE {} error={:?} stack={} MISMATCH", name, e, o.stack),
+    }
+}
+
+/// Displays scene `i`'s tolerance with its unit.
+#[cfg(not(feature = "defmt"))]
+struct Tolerance(usize);
+
+#[cfg(not(feature = "defmt"))]
+impl core::fmt::Display for Tolerance {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        if cfg!(feature = "micromath") {
+            write!(f, "{:e}rel", TOL_REL_MICROMATH[self.0])
+        } else {
+            write!(f, "{}ulp", TOL_ULP_LIBM[self.0])
+        }
     }
 }
 
@@ -220,13 +239,12 @@ fn start_log() {
 fn log_outcome(i: usize, o: &Outcome) {
     let name = scenes::NAMES[i];
     defmt::info!(
-        "CASE {=str} result={} host={=f32} host_bits={=u32:#010x} diff_ulp={=u32} tol_ulp={=u32} stack={=usize} ok={=bool}",
+        "CASE {=str} result={} host={=f32} host_bits={=u32:#010x} diff_ulp={=u32} stack={=usize} ok={=bool}",
         name,
         o.value,
         o.expected,
         o.expected.to_bits(),
         o.ulps,
-        TOLERANCE_ULP[i],
         o.stack,
         o.ok
     );

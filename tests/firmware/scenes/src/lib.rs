@@ -1,7 +1,8 @@
-//! The three f32 scenes the firmware computes. This one file is compiled twice: into the
-//! firmware (Cortex-M4F, the kernel with the firmware's features) and into the build script
-//! (the build machine, the kernel with host libm), which embeds its results as the expected
-//! values. Only `core` and the kernel are used here.
+//! The three f32 scenes the firmware computes. This crate is compiled twice: for the firmware
+//! (Cortex-M4F, the kernel with the firmware's features) and for its build script (the build
+//! machine, the kernel with host libm), which embeds its results as the expected values.
+
+#![no_std]
 
 use pdm_kernel::{
     form_factor_between, surface_form_factor, vec3, Parallelogram, Patch, PatchGrid, PdmError, Quadrature, Sphere,
