@@ -62,7 +62,7 @@ pub use pair::{pair_exchange, PairSettings};
 pub use patch::{Patch, PatchGrid};
 pub use real::Real;
 pub use samples::{Ball, PatchSamples, Sample};
-pub use singular::{classify, touching_exchange, Adjacency, SquareMap};
+pub use singular::{classify, classify_near, touching_exchange, Adjacency, SquareMap};
 pub use surface::{
     AutoNormal, BezierPatch, Cone, Cylinder, Disk, Flipped, Frame, ParamRect, Parallelogram, ParametricMap, Side,
     Sphere, Surface,

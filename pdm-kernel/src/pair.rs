@@ -1,6 +1,7 @@
 //! One entry point for any pair of patches: picks the integration method the pair needs.
 //!
-//! - Touching pairs (shared edge or vertex, found by [`classify`]) use the regularising
+//! - Touching pairs (shared edge or vertex, found by [`crate::singular::classify_near`], also
+//!   when they are only nearly touching) use the regularising
 //!   transforms of [`crate::singular`], converging exponentially with `singular_order`.
 //! - The same patch twice uses the interlaced-order self integral ([`crate::self_form_factor`]).
 //! - Separate pairs use the PDM sum at `order`, with the visibility boundaries (back-face cut
@@ -13,7 +14,7 @@ use crate::form_factor::exchange;
 use crate::patch::Patch;
 use crate::real::Real;
 use crate::samples::PatchSamples;
-use crate::singular::{classify, touching_exchange, Adjacency};
+use crate::singular::{classify_near, touching_exchange, Adjacency};
 use crate::surface::Surface;
 use crate::visibility::Occluder;
 
@@ -49,9 +50,10 @@ where
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
-    match classify(a, b) {
-        adjacency @ (Adjacency::SharedEdge { .. } | Adjacency::SharedVertex { .. }) => {
-            touching_exchange(a, b, adjacency, settings.singular_order, occluders)
+    let (adjacency, gap) = classify_near(a, b);
+    match adjacency {
+        Adjacency::SharedEdge { .. } | Adjacency::SharedVertex { .. } => {
+            touching_exchange(a, b, adjacency, gap, settings.singular_order, occluders)
         }
         Adjacency::Identical => {
             let f = crate::form_factor::self_form_factor::<T, SA, O, CAP>(a, settings.order, occluders)?;

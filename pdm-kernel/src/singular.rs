@@ -16,6 +16,11 @@
 //! tensor Gauss rule converges exponentially: machine precision for perpendicular unit squares
 //! by order ≈ 12.
 //!
+//! **Nearly folded pairs.** When the dihedral angle θ between the two patches is small (their
+//! normals at the edge nearly opposite), the kernel inside two of the pyramids peaks in a corner
+//! with width ≈ θ; those pyramids' inner variables are then split geometrically towards that
+//! corner (θ, 4θ, 16θ, …), which keeps the convergence exponential down to θ ≈ 1°.
+//!
 //! **Shared vertex.** Both patches are mapped so that the common corner is (0, 0); the 4-cube is
 //! split into four pyramids by its largest coordinate, Jacobian ζ³ (the singularity is 1/ζ²).
 //!
@@ -141,6 +146,36 @@ where
     SA: Surface<T> + ?Sized,
     SB: Surface<T> + ?Sized,
 {
+    contact(a, b, adjacency_tolerance::<T>()).0
+}
+
+/// Relative gap below which a pair that does not touch is still integrated with the touching
+/// transforms (graded towards the gap): 1 % of the patch size.
+pub const NEAR_CONTACT: f64 = 1e-2;
+
+/// Like [`classify`], but corners closer than [`NEAR_CONTACT`] × size also count as shared;
+/// returns the adjacency and the gap (largest distance between matched points, relative to the
+/// patch size; 0 up to rounding for patches that truly touch).
+#[must_use]
+pub fn classify_near<T, SA, SB>(a: &Patch<'_, T, SA>, b: &Patch<'_, T, SB>) -> (Adjacency, T)
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+{
+    let (adjacency, gap) = contact(a, b, T::from_f64(NEAR_CONTACT));
+    // A gap at the level of rounding is no gap: grading for it would only cost time.
+    let rounding = T::from_f64(64.0) * T::EPSILON;
+    (adjacency, if gap > rounding { gap } else { T::ZERO })
+}
+
+/// Adjacency at relative tolerance `rel_tol`, and the relative gap of the matched points.
+fn contact<T, SA, SB>(a: &Patch<'_, T, SA>, b: &Patch<'_, T, SB>, rel_tol: T) -> (Adjacency, T)
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+{
     let ca = corner_points(a);
     let cb = corner_points(b);
     let size = |c: &[Vec3<T>; 4]| {
@@ -153,8 +188,10 @@ where
         m
     };
     let magnitude = ca.iter().chain(cb.iter()).fold(T::ZERO, |m, p| m.max(p.max_abs()));
-    let tol = adjacency_tolerance::<T>() * size(&ca).max(size(&cb)) + T::from_f64(16.0) * T::EPSILON * magnitude;
+    let scale = size(&ca).max(size(&cb));
+    let tol = rel_tol * scale + T::from_f64(16.0) * T::EPSILON * magnitude;
     let same = |p: Vec3<T>, q: Vec3<T>| (p - q).norm() <= tol;
+    let gap_of = |p: Vec3<T>, q: Vec3<T>| if scale > T::ZERO { (p - q).norm() / scale } else { T::ZERO };
     // matches[i] = Some(j) if corner i of A coincides with corner j of B.
     let mut matches = [None; 4];
     let mut count = 0;
@@ -171,42 +208,50 @@ where
         }
     }
     match count {
-        0 => Adjacency::Separate,
+        0 => (Adjacency::Separate, T::ZERO),
         1 => {
             let Some((i, j)) = matches.iter().enumerate().find_map(|(i, m)| m.map(|j| (i, j))) else {
-                return Adjacency::Separate;
+                return (Adjacency::Separate, T::ZERO);
+            };
+            let gap = match (ca.get(i), cb.get(j)) {
+                (Some(p), Some(q)) => gap_of(*p, *q),
+                _ => T::ZERO,
             };
             // Any local orientation with (0,0) at the shared corner.
             match (SquareMap::from_corners(i, i ^ 1), SquareMap::from_corners(j, j ^ 1)) {
-                (Some(ma), Some(mb)) => Adjacency::SharedVertex { a: ma, b: mb },
-                _ => Adjacency::Separate,
+                (Some(ma), Some(mb)) => (Adjacency::SharedVertex { a: ma, b: mb }, gap),
+                _ => (Adjacency::Separate, T::ZERO),
             }
         }
         2 => {
             let mut it = matches.iter().enumerate().filter_map(|(i, m)| m.map(|j| (i, j)));
             let (Some((i1, j1)), Some((i2, j2))) = (it.next(), it.next()) else {
-                return Adjacency::Separate;
+                return (Adjacency::Separate, T::ZERO);
             };
             match (SquareMap::from_corners(i1, i2), SquareMap::from_corners(j1, j2)) {
                 (Some(ma), Some(mb)) => {
                     let la = Local { patch: a, map: ma };
                     let lb = Local { patch: b, map: mb };
-                    let agree = [0.25, 0.5, 0.75].iter().all(|&f| {
+                    let mut gap = T::ZERO;
+                    let mut agree = true;
+                    for f in [0.0, 0.25, 0.5, 0.75, 1.0] {
                         let f = T::from_f64(f);
-                        same(la.eval(f, T::ZERO).0, lb.eval(f, T::ZERO).0)
-                    });
+                        let (p, q) = (la.eval(f, T::ZERO).0, lb.eval(f, T::ZERO).0);
+                        agree = agree && same(p, q);
+                        gap = gap.max(gap_of(p, q));
+                    }
                     if agree {
-                        Adjacency::SharedEdge { a: ma, b: mb }
+                        (Adjacency::SharedEdge { a: ma, b: mb }, gap)
                     } else {
                         // Two corners in common that are not one edge of both, or an edge
                         // parameterised differently: the transform does not apply.
-                        Adjacency::Separate
+                        (Adjacency::Separate, T::ZERO)
                     }
                 }
-                _ => Adjacency::Separate,
+                _ => (Adjacency::Separate, T::ZERO),
             }
         }
-        _ => Adjacency::Identical,
+        _ => (Adjacency::Identical, T::ZERO),
     }
 }
 
@@ -218,6 +263,9 @@ fn unit_points<T: Real>(rule: &GaussRule<T>) -> impl Iterator<Item = (T, T)> + '
 
 /// The exchange A_a·F_{a→b} (symmetric) of two patches that share an edge or a vertex, by the
 /// transforms in the module docs with the `order`-point rule on each of the four variables.
+/// `gap` is the relative gap from [`classify_near`] (0 for patches that truly touch): for a
+/// positive gap the radial variable ζ is split geometrically at gap·4ᵏ so the near-singular
+/// peak is resolved.
 /// `Separate` pairs are refused (`Err(Degenerate)`) — use the plain sum for them; `Identical`
 /// pairs too (a patch's own F_ii needs [`crate::self_form_factor`]).
 ///
@@ -227,6 +275,7 @@ pub fn touching_exchange<T, SA, SB, O>(
     a: &Patch<'_, T, SA>,
     b: &Patch<'_, T, SB>,
     adjacency: Adjacency,
+    gap: T,
     order: usize,
     occluders: &O,
 ) -> Result<T, PdmError>
@@ -239,10 +288,13 @@ where
     let rule = GaussRule::<T>::new(order)?;
     let sum = match adjacency {
         Adjacency::SharedEdge { a: ma, b: mb } => {
-            edge_sum(&Local { patch: a, map: ma }, &Local { patch: b, map: mb }, &rule, occluders)
+            let (la, lb) = (Local { patch: a, map: ma }, Local { patch: b, map: mb });
+            let fold = fold_angle(&la, &lb);
+            graded(gap, |z0, z1| edge_sum(&la, &lb, &rule, occluders, z0, z1, fold))
         }
         Adjacency::SharedVertex { a: ma, b: mb } => {
-            vertex_sum(&Local { patch: a, map: ma }, &Local { patch: b, map: mb }, &rule, occluders)
+            let (la, lb) = (Local { patch: a, map: ma }, Local { patch: b, map: mb });
+            graded(gap, |z0, z1| vertex_sum(&la, &lb, &rule, occluders, z0, z1))
         }
         Adjacency::Separate | Adjacency::Identical => return Err(PdmError::Degenerate),
     };
@@ -251,6 +303,24 @@ where
         return Err(PdmError::InvalidResult);
     }
     Ok(value)
+}
+
+/// Σ over ζ-intervals [0, g], [g, 4g], [4g, 16g], … up to 1 (or just [0, 1] when g = 0 or g is
+/// not small).
+fn graded<T: Real>(gap: T, mut integral: impl FnMut(T, T) -> T) -> T {
+    if !(gap > T::ZERO) || !(gap < T::from_f64(0.25)) {
+        return integral(T::ZERO, T::ONE);
+    }
+    let four = T::from_f64(4.0);
+    let mut lo = T::ZERO;
+    let mut hi = gap;
+    let mut total = T::ZERO;
+    while lo < T::ONE {
+        total += integral(lo, hi);
+        lo = hi;
+        hi = (hi * four).min(T::ONE);
+    }
+    total
 }
 
 /// The kernel (n_a·e)(−n_b·e)/L⁴ with unnormalised (Jacobian-scaled) normals, zero where the
@@ -268,7 +338,15 @@ fn kernel<T: Real, O: Occluder<T> + ?Sized>(pa: Vec3<T>, na: Vec3<T>, pb: Vec3<T
     (ca * inv) * (cb * inv)
 }
 
-fn edge_sum<T, SA, SB, O>(a: &Local<'_, '_, T, SA>, b: &Local<'_, '_, T, SB>, rule: &GaussRule<T>, occ: &O) -> T
+fn edge_sum<T, SA, SB, O>(
+    a: &Local<'_, '_, T, SA>,
+    b: &Local<'_, '_, T, SB>,
+    rule: &GaussRule<T>,
+    occ: &O,
+    z0: T,
+    z1: T,
+    fold: T,
+) -> T
 where
     T: Real,
     SA: Surface<T> + ?Sized,
@@ -276,38 +354,96 @@ where
     O: Occluder<T> + ?Sized,
 {
     let mut total = T::ZERO;
-    for (zeta, wz) in unit_points(rule) {
-        let jac_zeta = zeta * zeta;
-        for (p, wp) in unit_points(rule) {
-            for (q, wq) in unit_points(rule) {
-                // The three pyramids: (|u|, η_a, η_b) = ζ(1,p,q), ζ(p,1,q), ζ(p,q,1).
-                for (abs_u, eta_a, eta_b) in [
-                    (zeta, zeta * p, zeta * q),
-                    (zeta * p, zeta, zeta * q),
-                    (zeta * p, zeta * q, zeta),
-                ] {
-                    let span = T::ONE - abs_u;
-                    let mut line = T::ZERO;
-                    for (sigma, ws) in unit_points(rule) {
-                        let lo = sigma * span;
-                        // u > 0: ξ_a = σ(1−u), ξ_b = ξ_a + u;  u < 0: ξ_b = σ(1−|u|), ξ_a = ξ_b + |u|.
-                        let (pa, na) = a.eval(lo, eta_a);
-                        let (pb, nb) = b.eval(lo + abs_u, eta_b);
-                        let mut k = kernel(pa, na, pb, nb, occ);
-                        let (pa2, na2) = a.eval(lo + abs_u, eta_a);
-                        let (pb2, nb2) = b.eval(lo, eta_b);
-                        k += kernel(pa2, na2, pb2, nb2, occ);
-                        line += ws * k;
+    let dz = z1 - z0;
+    // Pyramid k: the largest of (|u|, η_a, η_b) is ζ. In pyramids 1 and 2 the kernel of two
+    // nearly folded patches peaks at p → 0 (u = 0), q → 1 (η_a = η_b) with width ≈ the fold
+    // angle: grade p and q towards that corner.
+    for pyramid in 0..3 {
+        let scale = if pyramid == 0 { T::ZERO } else { fold };
+        for_each_interval(scale, false, |p0, p1| {
+            for_each_interval(scale, true, |q0, q1| {
+                let (dp, dq) = (p1 - p0, q1 - q0);
+                for (zu, wz) in unit_points(rule) {
+                    let (zeta, wz) = (z0 + dz * zu, wz * dz);
+                    let jac_zeta = zeta * zeta;
+                    for (pu, wp) in unit_points(rule) {
+                        let (p, wp) = (p0 + dp * pu, wp * dp);
+                        for (qu, wq) in unit_points(rule) {
+                            let (q, wq) = (q0 + dq * qu, wq * dq);
+                            let (abs_u, eta_a, eta_b) = match pyramid {
+                                0 => (zeta, zeta * p, zeta * q),
+                                1 => (zeta * p, zeta, zeta * q),
+                                _ => (zeta * p, zeta * q, zeta),
+                            };
+                            let span = T::ONE - abs_u;
+                            let mut line = T::ZERO;
+                            for (sigma, ws) in unit_points(rule) {
+                                let lo = sigma * span;
+                                // u > 0: ξ_a = σ(1−u), ξ_b = ξ_a + u;  u < 0: ξ_b = σ(1−|u|), ξ_a = ξ_b + |u|.
+                                let (pa, na) = a.eval(lo, eta_a);
+                                let (pb, nb) = b.eval(lo + abs_u, eta_b);
+                                let mut k = kernel(pa, na, pb, nb, occ);
+                                let (pa2, na2) = a.eval(lo + abs_u, eta_a);
+                                let (pb2, nb2) = b.eval(lo, eta_b);
+                                k += kernel(pa2, na2, pb2, nb2, occ);
+                                line += ws * k;
+                            }
+                            total += wz * wp * wq * jac_zeta * span * line;
+                        }
                     }
-                    total += wz * wp * wq * jac_zeta * span * line;
                 }
-            }
-        }
+            });
+        });
     }
     total
 }
 
-fn vertex_sum<T, SA, SB, O>(a: &Local<'_, '_, T, SA>, b: &Local<'_, '_, T, SB>, rule: &GaussRule<T>, occ: &O) -> T
+/// Calls `f(lo, hi)` for the intervals of [0, 1] graded geometrically towards 0 (or towards 1
+/// if `toward_one`): [0, δ], [δ, 4δ], [4δ, 16δ], …; just [0, 1] when δ is 0 or ≥ 1.
+fn for_each_interval<T: Real>(scale: T, toward_one: bool, mut f: impl FnMut(T, T)) {
+    if !(scale > T::ZERO && scale < T::ONE) {
+        f(T::ZERO, T::ONE);
+        return;
+    }
+    let four = T::from_f64(4.0);
+    let (mut lo, mut hi) = (T::ZERO, scale);
+    while lo < T::ONE {
+        if toward_one {
+            f(T::ONE - hi, T::ONE - lo);
+        } else {
+            f(lo, hi);
+        }
+        lo = hi;
+        hi = (hi * four).min(T::ONE);
+    }
+}
+
+/// The fold parameter of an edge pair: ≈ the dihedral angle when the two patches are nearly
+/// folded onto each other (normals at the middle of the common edge nearly opposite), from
+/// |n̂_a + n̂_b|; large (no grading) otherwise.
+fn fold_angle<T, SA, SB>(a: &Local<'_, '_, T, SA>, b: &Local<'_, '_, T, SB>) -> T
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+{
+    let (_, na) = a.eval(T::HALF, T::ZERO);
+    let (_, nb) = b.eval(T::HALF, T::ZERO);
+    let (la, lb) = (na.norm(), nb.norm());
+    if !(la > T::ZERO && lb > T::ZERO) {
+        return T::ONE;
+    }
+    (na.scale(T::ONE / la) + nb.scale(T::ONE / lb)).norm()
+}
+
+fn vertex_sum<T, SA, SB, O>(
+    a: &Local<'_, '_, T, SA>,
+    b: &Local<'_, '_, T, SB>,
+    rule: &GaussRule<T>,
+    occ: &O,
+    z0: T,
+    z1: T,
+) -> T
 where
     T: Real,
     SA: Surface<T> + ?Sized,
@@ -315,7 +451,9 @@ where
     O: Occluder<T> + ?Sized,
 {
     let mut total = T::ZERO;
-    for (zeta, wz) in unit_points(rule) {
+    let dz = z1 - z0;
+    for (zu, wz) in unit_points(rule) {
+        let (zeta, wz) = (z0 + dz * zu, wz * dz);
         let jac = zeta * zeta * zeta;
         for (p, wp) in unit_points(rule) {
             for (q, wq) in unit_points(rule) {
