@@ -112,8 +112,10 @@ where
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
-    let sa = PatchSamples::<T, CAP>::new(a, quadrature.order_a)?;
-    let sb = PatchSamples::<T, CAP>::new(b, quadrature.order_b)?;
+    let mut sa = PatchSamples::<T, CAP>::empty();
+    let mut sb = PatchSamples::<T, CAP>::empty();
+    sa.fill(a, quadrature.order_a, quadrature.order_a)?;
+    sb.fill(b, quadrature.order_b, quadrature.order_b)?;
     form_factor(&sa, &sb, occluders)
 }
 
@@ -165,11 +167,13 @@ where
 {
     let mut total_area = T::ZERO;
     let mut total_exchange = T::ZERO;
+    let mut sa = PatchSamples::<T, CAP>::empty();
+    let mut sb = PatchSamples::<T, CAP>::empty();
     for pa in a {
-        let sa = PatchSamples::<T, CAP>::new(&pa, quadrature.order_a)?;
+        sa.fill(&pa, quadrature.order_a, quadrature.order_a)?;
         total_area += sa.area();
         for pb in b.clone() {
-            let sb = PatchSamples::<T, CAP>::new(&pb, quadrature.order_b)?;
+            sb.fill(&pb, quadrature.order_b, quadrature.order_b)?;
             total_exchange += exchange(&sa, &sb, occluders)?;
         }
     }

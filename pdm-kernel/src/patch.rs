@@ -192,7 +192,8 @@ mod tests {
         let s32 = Sphere::outer(vec3(0.0_f32, 0.0, 0.0), r as f32).unwrap();
         let rect32 = ParamRect::new(p0 as f32, p1 as f32, 0.0, 2.0 * core::f32::consts::PI).unwrap();
         let a32 = Patch::new(&s32, rect32).unwrap().area(12).unwrap() as f64;
-        assert!((a32 - exact).abs() / exact < 2e-6, "f32 {a32} vs {exact}");
+        let allowed = if cfg!(feature = "micromath") { 5e-3 } else { 2e-6 };
+        assert!((a32 - exact).abs() / exact < allowed, "f32 {a32} vs {exact}");
     }
 
     #[test]

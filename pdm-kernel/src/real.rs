@@ -64,6 +64,10 @@ pub trait Real:
     const GEOMETRY_TOLERANCE: Self;
     /// Number of mantissa bits (24 or 53); used in docs and tests.
     const MANTISSA_DIGITS: u32;
+    /// Relative error bound of the elementary functions of the active math backend (a couple of
+    /// ε with libm; ≈ 2e-3 for f32 with the `micromath` feature). Points computed through
+    /// sin/cos lie this far (relatively) off their exact surface.
+    const ELEMENTARY_ERROR: Self;
 
     /// Converts an `f64` constant to this width (rounding to nearest for `f32`).
     fn from_f64(x: f64) -> Self;
@@ -109,6 +113,7 @@ macro_rules! impl_real {
             const MIN_POSITIVE: Self = <$t>::MIN_POSITIVE;
             const GEOMETRY_TOLERANCE: Self = $tol;
             const MANTISSA_DIGITS: u32 = <$t>::MANTISSA_DIGITS;
+            const ELEMENTARY_ERROR: Self = math::$math::ELEMENTARY_ERROR;
 
             #[inline(always)]
             fn from_f64(x: f64) -> Self {

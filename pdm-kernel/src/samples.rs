@@ -58,13 +58,15 @@ impl<T: Real, const CAP: usize> PatchSamples<T, CAP> {
         order_t: usize,
         order_s: usize,
     ) -> Result<Self, PdmError> {
-        let rule_t = GaussRule::<T>::new(order_t)?;
-        let rule_s = GaussRule::<T>::new(order_s)?;
-        let needed = order_t * order_s;
-        if needed > CAP {
-            return Err(PdmError::CapacityExceeded { needed, capacity: CAP });
-        }
-        let mut out = Self {
+        let mut out = Self::empty();
+        out.fill(patch, order_t, order_s)?;
+        Ok(out)
+    }
+
+    /// An empty set (no samples), to be filled in place with [`PatchSamples::fill`].
+    #[must_use]
+    pub const fn empty() -> Self {
+        Self {
             len: 0,
             x: [T::ZERO; CAP],
             y: [T::ZERO; CAP],
@@ -74,8 +76,27 @@ impl<T: Real, const CAP: usize> PatchSamples<T, CAP> {
             nz: [T::ZERO; CAP],
             w: [T::ZERO; CAP],
             area: T::ZERO,
-            bounds: Ball { center: Vec3::ZERO, radius: T::ZERO },
-        };
+            bounds: Ball { center: Vec3 { x: T::ZERO, y: T::ZERO, z: T::ZERO }, radius: T::ZERO },
+        }
+    }
+
+    /// Re-samples `patch` into this buffer in place (no copy of the arrays: this is what keeps a
+    /// form-factor call within a small stack on a microcontroller). Same errors as
+    /// [`PatchSamples::with_orders`]; on error the buffer is left empty.
+    pub fn fill<S: Surface<T> + ?Sized>(
+        &mut self,
+        patch: &Patch<'_, T, S>,
+        order_t: usize,
+        order_s: usize,
+    ) -> Result<(), PdmError> {
+        self.len = 0;
+        self.area = T::ZERO;
+        let rule_t = GaussRule::<T>::new(order_t)?;
+        let rule_s = GaussRule::<T>::new(order_s)?;
+        let needed = order_t * order_s;
+        if needed > CAP {
+            return Err(PdmError::CapacityExceeded { needed, capacity: CAP });
+        }
         let r = patch.rect();
         let surface = patch.surface();
         let ht = (r.t1 - r.t0) * T::HALF;
@@ -94,25 +115,26 @@ impl<T: Real, const CAP: usize> PatchSamples<T, CAP> {
                 let len = n.norm();
                 let unit = if len > T::ZERO { n.scale(T::ONE / len) } else { Vec3::ZERO };
                 let w = wt * ws * jacobian * len;
-                out.set(k, p, unit, w);
+                self.set(k, p, unit, w);
                 area += w;
                 k += 1;
             }
         }
-        out.len = k;
         if !area.is_finite() {
             return Err(PdmError::NonFinite);
         }
-        out.area = area;
-        out.bounds = out.compute_bounds();
+        self.len = k;
+        self.bounds = self.compute_bounds();
         let (extent, magnitude) = patch_extent(patch);
         let tiny = T::GEOMETRY_TOLERANCE * T::GEOMETRY_TOLERANCE * extent * extent;
         // A patch whose extent is lost in the rounding of its coordinates is a point.
         let lost_in_rounding = extent <= T::GEOMETRY_TOLERANCE * magnitude;
         if !(area > T::ZERO) || !(area > tiny) || !extent.is_finite() || lost_in_rounding {
+            self.len = 0;
             return Err(PdmError::Degenerate);
         }
-        Ok(out)
+        self.area = area;
+        Ok(())
     }
 
     fn set(&mut self, k: usize, p: Vec3<T>, n: Vec3<T>, w: T) {

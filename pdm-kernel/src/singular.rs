@@ -353,7 +353,8 @@ where
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
-    let mut total = T::ZERO;
+    // Compensated: up to 6·order⁴·(grading) terms, summed in f32 too.
+    let mut total = Compensated::default();
     let dz = z1 - z0;
     // Pyramid k: the largest of (|u|, η_a, η_b) is ζ. In pyramids 1 and 2 the kernel of two
     // nearly folded patches peaks at p → 0 (u = 0), q → 1 (η_a = η_b) with width ≈ the fold
@@ -388,14 +389,38 @@ where
                                 k += kernel(pa2, na2, pb2, nb2, occ);
                                 line += ws * k;
                             }
-                            total += wz * wp * wq * jac_zeta * span * line;
+                            total.add(wz * wp * wq * jac_zeta * span * line);
                         }
                     }
                 }
             });
         });
     }
-    total
+    total.value()
+}
+
+/// Kahan–Babuška (Neumaier) compensated sum.
+#[derive(Clone, Copy, Default)]
+struct Compensated<T> {
+    sum: T,
+    carry: T,
+}
+
+impl<T: Real> Compensated<T> {
+    #[inline(always)]
+    fn add(&mut self, x: T) {
+        let t = self.sum + x;
+        if self.sum.abs() >= x.abs() {
+            self.carry += (self.sum - t) + x;
+        } else {
+            self.carry += (x - t) + self.sum;
+        }
+        self.sum = t;
+    }
+    #[inline(always)]
+    fn value(self) -> T {
+        self.sum + self.carry
+    }
 }
 
 /// Calls `f(lo, hi)` for the intervals of [0, 1] graded geometrically towards 0 (or towards 1
@@ -450,7 +475,7 @@ where
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
-    let mut total = T::ZERO;
+    let mut total = Compensated::default();
     let dz = z1 - z0;
     for (zu, wz) in unit_points(rule) {
         let (zeta, wz) = (z0 + dz * zu, wz * dz);
@@ -466,10 +491,10 @@ where
                         let (pb, nb) = b.eval(xb, yb);
                         k += kernel(pa, na, pb, nb, occ);
                     }
-                    total += wz * wp * wq * wr * jac * k;
+                    total.add(wz * wp * wq * wr * jac * k);
                 }
             }
         }
     }
-    total
+    total.value()
 }

@@ -139,10 +139,11 @@ fn crossing_of_quadric<T: Real>(a: T, b: T, c_p: T, c_q: T, scale: T, accept: im
 }
 
 /// `true` if a quadric's value `c` at a point is zero up to the rounding of evaluating it at
-/// that scale (`scale` ≈ R²): the point lies on the surface.
+/// that scale (`scale` ≈ R²) — and up to the error of the elementary functions that placed the
+/// point ([`Real::ELEMENTARY_ERROR`], large with micromath): the point lies on the surface.
 #[inline(always)]
 fn on_surface<T: Real>(c: T, scale: T) -> bool {
-    c.abs() <= T::from_f64(64.0) * T::EPSILON * scale
+    c.abs() <= (T::from_f64(64.0) * T::EPSILON + T::from_f64(16.0) * T::ELEMENTARY_ERROR) * scale
 }
 
 impl<T: Real> Occluder<T> for Parallelogram<T> {
