@@ -33,7 +33,11 @@ mod expected {
 }
 
 /// The math backend this build uses.
-const BACKEND: &str = if cfg!(feature = "micromath") { "micromath" } else { "libm" };
+const BACKEND: &str = if cfg!(feature = "micromath") {
+    "micromath"
+} else {
+    "libm"
+};
 
 /// Tolerance per scene of the libm build, in units in the last place (ulp) of f32 between the
 /// firmware's value and the host's (both positive: the ulp distance is the difference of the
@@ -154,10 +158,23 @@ fn main() -> ! {
         };
         all_ok &= ok;
         max_stack = max_stack.max(stack);
-        log_outcome(i, &Outcome { value, expected, ulps, stack, ok });
+        log_outcome(
+            i,
+            &Outcome {
+                value,
+                expected,
+                ulps,
+                stack,
+                ok,
+            },
+        );
     }
     finish_log(max_stack, all_ok);
-    debug::exit(if all_ok { debug::EXIT_SUCCESS } else { debug::EXIT_FAILURE });
+    debug::exit(if all_ok {
+        debug::EXIT_SUCCESS
+    } else {
+        debug::EXIT_FAILURE
+    });
     #[allow(clippy::empty_loop)]
     loop {}
 }
@@ -239,9 +256,10 @@ fn start_log() {
 fn log_outcome(i: usize, o: &Outcome) {
     let name = scenes::NAMES[i];
     defmt::info!(
-        "CASE {=str} result={} host={=f32} host_bits={=u32:#010x} diff_ulp={=u32} stack={=usize} ok={=bool}",
+        "CASE {=str} result={} bits={=u32:#010x} host={=f32} host_bits={=u32:#010x} diff_ulp={=u32} stack={=usize} ok={=bool}",
         name,
         o.value,
+        o.value.map(f32::to_bits).unwrap_or(0),
         o.expected,
         o.expected.to_bits(),
         o.ulps,

@@ -5,7 +5,8 @@
 #![no_std]
 
 use pdm_kernel::{
-    form_factor_between, surface_form_factor, vec3, Parallelogram, Patch, PatchGrid, PdmError, Quadrature, Sphere,
+    form_factor_between, surface_form_factor, vec3, Parallelogram, Patch, PatchGrid, PdmError,
+    Quadrature, Sphere,
 };
 
 /// Gauss order per axis on each patch (the paper's 5).
@@ -23,7 +24,11 @@ pub const NAMES: [&str; COUNT] = ["sphere_to_face", "shared_edge", "occluded_pai
 #[inline(never)]
 pub fn sphere_to_face() -> Result<f32, PdmError> {
     let sphere = Sphere::outer(vec3(0.0_f32, 0.0, 0.0), 1.0)?;
-    let floor = Parallelogram::new(vec3(-3.0_f32, -3.0, -3.0), vec3(6.0, 0.0, 0.0), vec3(0.0, 6.0, 0.0))?;
+    let floor = Parallelogram::new(
+        vec3(-3.0_f32, -3.0, -3.0),
+        vec3(6.0, 0.0, 0.0),
+        vec3(0.0, 6.0, 0.0),
+    )?;
     surface_form_factor::<f32, _, _, _, CAP>(
         PatchGrid::new(&sphere, 4, 8)?,
         PatchGrid::new(&floor, 3, 3)?,
@@ -37,18 +42,43 @@ pub fn sphere_to_face() -> Result<f32, PdmError> {
 /// the plain Gauss rule overestimates it at a shared edge (the integrand is singular there).
 #[inline(never)]
 pub fn shared_edge() -> Result<f32, PdmError> {
-    let floor = Parallelogram::new(vec3(0.0_f32, 0.0, 0.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0))?;
-    let wall = Parallelogram::new(vec3(0.0_f32, 0.0, 0.0), vec3(0.0, 0.0, 1.0), vec3(1.0, 0.0, 0.0))?;
-    form_factor_between::<f32, _, _, _, CAP>(&Patch::whole(&floor)?, &Patch::whole(&wall)?, Quadrature::uniform(ORDER), &())
+    let floor = Parallelogram::new(
+        vec3(0.0_f32, 0.0, 0.0),
+        vec3(1.0, 0.0, 0.0),
+        vec3(0.0, 1.0, 0.0),
+    )?;
+    let wall = Parallelogram::new(
+        vec3(0.0_f32, 0.0, 0.0),
+        vec3(0.0, 0.0, 1.0),
+        vec3(1.0, 0.0, 0.0),
+    )?;
+    form_factor_between::<f32, _, _, _, CAP>(
+        &Patch::whole(&floor)?,
+        &Patch::whole(&wall)?,
+        Quadrature::uniform(ORDER),
+        &(),
+    )
 }
 
 /// Two parallel unit squares at distance 1 facing each other (0.1998 unoccluded), with a
 /// 0.5 × 0.5 square occluder centred between them in the plane z = 0.5.
 #[inline(never)]
 pub fn occluded_pair() -> Result<f32, PdmError> {
-    let lower = Parallelogram::new(vec3(0.0_f32, 0.0, 0.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0))?;
-    let upper = Parallelogram::new(vec3(0.0_f32, 0.0, 1.0), vec3(0.0, 1.0, 0.0), vec3(1.0, 0.0, 0.0))?;
-    let blocker = Parallelogram::new(vec3(0.25_f32, 0.25, 0.5), vec3(0.5, 0.0, 0.0), vec3(0.0, 0.5, 0.0))?;
+    let lower = Parallelogram::new(
+        vec3(0.0_f32, 0.0, 0.0),
+        vec3(1.0, 0.0, 0.0),
+        vec3(0.0, 1.0, 0.0),
+    )?;
+    let upper = Parallelogram::new(
+        vec3(0.0_f32, 0.0, 1.0),
+        vec3(0.0, 1.0, 0.0),
+        vec3(1.0, 0.0, 0.0),
+    )?;
+    let blocker = Parallelogram::new(
+        vec3(0.25_f32, 0.25, 0.5),
+        vec3(0.5, 0.0, 0.0),
+        vec3(0.0, 0.5, 0.0),
+    )?;
     form_factor_between::<f32, _, _, _, CAP>(
         &Patch::whole(&lower)?,
         &Patch::whole(&upper)?,
