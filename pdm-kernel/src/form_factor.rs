@@ -196,30 +196,93 @@ where
     O: Occluder<T> + ?Sized,
 {
     let (ax, ay, az, anx, any, anz, aw) = a.columns();
-    let (bx, by, bz, bnx, bny, bnz, bw) = b.columns();
+    let cols = b.columns();
     let mut total = T::ZERO;
     let outer = ax.iter().zip(ay).zip(az).zip(anx).zip(any).zip(anz).zip(aw);
     for ((((((&px, &py), &pz), &nxa), &nya), &nza), &wa) in outer {
-        let mut inner = T::ZERO;
-        let cols = bx.iter().zip(by).zip(bz).zip(bnx).zip(bny).zip(bnz).zip(bw);
-        for ((((((&qx, &qy), &qz), &nxb), &nyb), &nzb), &wb) in cols {
-            let (dx, dy, dz) = (qx - px, qy - py, qz - pz);
-            let l2 = dx * dx + dy * dy + dz * dz;
-            let ca = nxa * dx + nya * dy + nza * dz;
-            let cb = -(nxb * dx + nyb * dy + nzb * dz);
-            // Curvature test, sections 3.1–3.2 (both dot products); l2 > 0 excludes coincident points.
-            if !(ca > T::ZERO && cb > T::ZERO && l2 > T::ZERO) {
-                continue;
-            }
-            if let Some(o) = occluders {
-                if o.blocks(crate::vec3::vec3(px, py, pz), crate::vec3::vec3(qx, qy, qz)) {
-                    continue;
-                }
-            }
-            let inv = T::ONE / l2;
-            inner += wb * (ca * inv) * (cb * inv);
-        }
+        let inner = match occluders {
+            None => inner_sum_unoccluded([px, py, pz], [nxa, nya, nza], cols),
+            Some(o) => inner_sum_occluded([px, py, pz], [nxa, nya, nza], cols, o),
+        };
         total += wa * inner;
     }
     total
+}
+
+/// Lanes of the branch-free inner loop: independent partial sums that the compiler keeps in
+/// SIMD registers (no reassociation of one sum is needed, so no fast-math).
+const LANES: usize = 8;
+
+type Columns<'c, T> = (&'c [T], &'c [T], &'c [T], &'c [T], &'c [T], &'c [T], &'c [T]);
+
+/// One term of the sum: w_b (n̂_a·e/L²)(−n̂_b·e/L²) if the pair passes both curvature tests
+/// (sections 3.1–3.2), else 0; branch-free.
+#[inline(always)]
+fn term<T: Real>(p: [T; 3], n: [T; 3], q: [T; 3], m: [T; 3], wb: T) -> T {
+    let [px, py, pz] = p;
+    let [nx, ny, nz] = n;
+    let (dx, dy, dz) = (q[0] - px, q[1] - py, q[2] - pz);
+    let l2 = dx * dx + dy * dy + dz * dz;
+    let ca = nx * dx + ny * dy + nz * dz;
+    let cb = -(m[0] * dx + m[1] * dy + m[2] * dz);
+    // l2 > 0 excludes coincident points (a patch against itself at the same node).
+    let visible = ca > T::ZERO && cb > T::ZERO && l2 > T::ZERO;
+    let inv = T::ONE / if visible { l2 } else { T::ONE };
+    let value = wb * (ca * inv) * (cb * inv);
+    if visible {
+        value
+    } else {
+        T::ZERO
+    }
+}
+
+/// Inner sum without occluders, in `LANES` independent partial sums.
+#[inline(always)]
+fn inner_sum_unoccluded<T: Real>(p: [T; 3], n: [T; 3], cols: Columns<'_, T>) -> T {
+    let (bx, by, bz, bnx, bny, bnz, bw) = cols;
+    let mut lanes = [T::ZERO; LANES];
+    let chunks = bx
+        .chunks_exact(LANES)
+        .zip(by.chunks_exact(LANES))
+        .zip(bz.chunks_exact(LANES))
+        .zip(bnx.chunks_exact(LANES))
+        .zip(bny.chunks_exact(LANES))
+        .zip(bnz.chunks_exact(LANES))
+        .zip(bw.chunks_exact(LANES));
+    for ((((((cx, cy), cz), cnx), cny), cnz), cw) in chunks {
+        let lane_iter = lanes.iter_mut().zip(cx).zip(cy).zip(cz).zip(cnx).zip(cny).zip(cnz).zip(cw);
+        for (((((((acc, &qx), &qy), &qz), &mx), &my), &mz), &wb) in lane_iter {
+            *acc += term(p, n, [qx, qy, qz], [mx, my, mz], wb);
+        }
+    }
+    let done = bx.len() - bx.len() % LANES;
+    fn rest<T>(c: &[T], done: usize) -> &[T] {
+        c.get(done..).unwrap_or_default()
+    }
+    let rest = |c| rest(c, done);
+    let tail = rest(bx).iter().zip(rest(by)).zip(rest(bz)).zip(rest(bnx)).zip(rest(bny)).zip(rest(bnz)).zip(rest(bw));
+    let mut sum = T::ZERO;
+    for ((((((&qx, &qy), &qz), &mx), &my), &mz), &wb) in tail {
+        sum += term(p, n, [qx, qy, qz], [mx, my, mz], wb);
+    }
+    for lane in lanes {
+        sum += lane;
+    }
+    sum
+}
+
+/// Inner sum with occluders: the occlusion test runs only for pairs that pass the curvature test.
+#[inline(always)]
+fn inner_sum_occluded<T: Real, O: Occluder<T> + ?Sized>(p: [T; 3], n: [T; 3], cols: Columns<'_, T>, occluders: &O) -> T {
+    let (bx, by, bz, bnx, bny, bnz, bw) = cols;
+    let pv = crate::vec3::vec3(p[0], p[1], p[2]);
+    let mut inner = T::ZERO;
+    let it = bx.iter().zip(by).zip(bz).zip(bnx).zip(bny).zip(bnz).zip(bw);
+    for ((((((&qx, &qy), &qz), &mx), &my), &mz), &wb) in it {
+        let t = term(p, n, [qx, qy, qz], [mx, my, mz], wb);
+        if t > T::ZERO && !occluders.blocks(pv, crate::vec3::vec3(qx, qy, qz)) {
+            inner += t;
+        }
+    }
+    inner
 }

@@ -93,7 +93,22 @@ impl<T: Real, const CAP: usize> PatchSamples<T, CAP> {
         self.area = T::ZERO;
         let rule_t = GaussRule::<T>::new(order_t)?;
         let rule_s = GaussRule::<T>::new(order_s)?;
-        let needed = order_t * order_s;
+        self.fill_with_rules(patch, &rule_t, &rule_s)
+    }
+
+    /// [`PatchSamples::fill`] with the rules given instead of their orders: `rule_t` along t,
+    /// `rule_s` along s. With rules built by [`GaussRule::fixed`] a build links only those
+    /// orders' tables. Same errors as [`PatchSamples::with_orders`] except `UnsupportedOrder`
+    /// (a rule is always valid); on error the buffer is left empty.
+    pub fn fill_with_rules<S: Surface<T> + ?Sized>(
+        &mut self,
+        patch: &Patch<'_, T, S>,
+        rule_t: &GaussRule<T>,
+        rule_s: &GaussRule<T>,
+    ) -> Result<(), PdmError> {
+        self.len = 0;
+        self.area = T::ZERO;
+        let needed = rule_t.order() * rule_s.order();
         if needed > CAP {
             return Err(PdmError::CapacityExceeded { needed, capacity: CAP });
         }

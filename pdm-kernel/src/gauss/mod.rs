@@ -8,8 +8,16 @@
 //! with multi-precision arithmetic and fails if any bit differs.
 //!
 //! Nodes are stored sorted ascending; node k and node n−1−k are negatives of each other.
+//!
+//! **What a build links.** Each order and width has its own statics. [`GaussRule::new`] takes the
+//! order at run time and therefore links the tables of every order (4.2 KB in f32, 8.4 KB in f64);
+//! [`GaussRule::fixed`] takes it at compile time and links that order's 2·n values only (40 B for
+//! order 5 in f32), and [`GaussRule::new_up_to`] takes a run-time order up to a compile-time
+//! bound and links orders 1..=bound. The rules are the same bits whichever way they are built.
 
 pub(crate) mod tables;
+
+use core::any::Any;
 
 use crate::error::PdmError;
 use crate::real::Real;
@@ -33,6 +41,55 @@ impl<T: Real> GaussRule<T> {
             Some((nodes, weights)) => Ok(Self { nodes, weights }),
             None => Err(PdmError::UnsupportedOrder { order }),
         }
+    }
+
+    /// The N-point rule, N checked at compile time (`1 ≤ N ≤ MAX_ORDER`, else the build fails).
+    /// Links only order N's table (2·N values), not the tables of every order as
+    /// [`GaussRule::new`] does: for firmware that uses one order.
+    ///
+    /// ```
+    /// use pdm_kernel::GaussRule;
+    /// let rule = GaussRule::<f32>::fixed::<5>();
+    /// assert_eq!(rule.order(), 5);
+    /// assert_eq!(rule.nodes(), GaussRule::<f32>::new(5)?.nodes());
+    /// # Ok::<(), pdm_kernel::PdmError>(())
+    /// ```
+    ///
+    /// ```compile_fail
+    /// let rule = pdm_kernel::GaussRule::<f32>::fixed::<0>(); // order 0: a build error
+    /// ```
+    #[inline(always)]
+    #[must_use]
+    pub fn fixed<const N: usize>() -> Self {
+        const {
+            assert!(N >= 1 && N <= tables::MAX_ORDER, "Gauss order must be in 1..=MAX_ORDER");
+        }
+        let (nodes, weights) = of_width::<T>(tables::fixed_f32::<N>, tables::fixed_f64::<N>);
+        Self { nodes, weights }
+    }
+
+    /// The n-point rule for a run-time `order` in `1..=MAX` (`MAX ≤ MAX_ORDER`, checked at compile
+    /// time), `Err(UnsupportedOrder)` otherwise. Links the tables of orders 1..=MAX only.
+    ///
+    /// ```
+    /// use pdm_kernel::GaussRule;
+    /// assert_eq!(GaussRule::<f64>::new_up_to::<16>(8)?.weights(), GaussRule::<f64>::new(8)?.weights());
+    /// assert!(GaussRule::<f64>::new_up_to::<16>(17).is_err());
+    /// # Ok::<(), pdm_kernel::PdmError>(())
+    /// ```
+    pub fn new_up_to<const MAX: usize>(order: usize) -> Result<Self, PdmError> {
+        const {
+            assert!(MAX <= tables::MAX_ORDER, "MAX must not exceed MAX_ORDER");
+        }
+        macro_rules! select {
+            ($($n:literal)*) => {
+                match order {
+                    $($n if $n <= MAX => Ok(Self::fixed::<$n>()),)*
+                    _ => Err(PdmError::UnsupportedOrder { order }),
+                }
+            };
+        }
+        select!(1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25 26 27 28 29 30 31 32)
     }
 
     /// Number of points n.
@@ -74,18 +131,35 @@ impl<T: Real> GaussRule<T> {
     }
 }
 
-/// Slices order `order` out of one flat generated table; `None` outside `1..=MAX_ORDER`.
+/// Order `order`'s nodes and weights out of the generated per-order index (`NODES_F32`, …:
+/// entry n is order n's table); `None` outside `1..=MAX_ORDER`.
 pub(crate) fn rule_slices<T>(
-    nodes: &'static [T],
-    weights: &'static [T],
+    nodes: &'static [&'static [T]],
+    weights: &'static [&'static [T]],
     order: usize,
 ) -> Option<(&'static [T], &'static [T])> {
     if order == 0 || order > tables::MAX_ORDER {
         return None;
     }
-    let start = *tables::OFFSETS.get(order)?;
-    let end = *tables::OFFSETS.get(order + 1)?;
-    Some((nodes.get(start..end)?, weights.get(start..end)?))
+    Some((*nodes.get(order)?, *weights.get(order)?))
+}
+
+/// The f32 or the f64 table as `T`'s (`Real` is sealed to these two widths). The width test is a
+/// comparison of type ids that the compiler resolves, so only the matching branch, and only its
+/// tables, remain in the build.
+#[inline(always)]
+fn of_width<T: Real>(
+    f32s: impl FnOnce() -> (&'static [f32], &'static [f32]),
+    f64s: impl FnOnce() -> (&'static [f64], &'static [f64]),
+) -> (&'static [T], &'static [T]) {
+    let mut out: Option<(&'static [T], &'static [T])> = None;
+    let slot: &mut dyn Any = &mut out;
+    if let Some(o) = slot.downcast_mut::<Option<(&'static [f32], &'static [f32])>>() {
+        *o = Some(f32s());
+    } else if let Some(o) = slot.downcast_mut::<Option<(&'static [f64], &'static [f64])>>() {
+        *o = Some(f64s());
+    }
+    out.unwrap_or((&[], &[]))
 }
 
 #[cfg(test)]
