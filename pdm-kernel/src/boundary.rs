@@ -44,6 +44,25 @@ where
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
+    boundary_exchange_counted::<T, SA, SB, O, CAP>(a, b, order, occluders).map(|(v, _)| v)
+}
+
+/// [`boundary_exchange`] and the number of integrand evaluations it made (kernel evaluations
+/// plus visibility probes, each of which evaluates the surface and the visibility tests).
+pub fn boundary_exchange_counted<T, SA, SB, O, const CAP: usize>(
+    a: &Patch<'_, T, SA>,
+    b: &Patch<'_, T, SB>,
+    order: usize,
+    occluders: &O,
+) -> Result<(T, u64), PdmError>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
+    let count = core::cell::Cell::new(0u64);
+    let tick = || count.set(count.get().saturating_add(1));
     let outer = PatchSamples::<T, CAP>::new(a, order)?;
     let inner_samples = PatchSamples::<T, CAP>::new(b, order)?; // validates b (area, finiteness)
     let use_occluders = occluders.may_block_between(&outer.bounds(), &inner_samples.bounds());
@@ -59,6 +78,7 @@ where
         let p = sample.point;
         let np = sample.unit_normal;
         let visible = |q: Vec3<T>, nq: Vec3<T>| {
+            tick();
             let e = q - p;
             np.dot(e) > T::ZERO && nq.dot(e) < T::ZERO && !(use_occluders && occluders.blocks(p, q))
         };
@@ -117,6 +137,7 @@ where
                     let mut piece = T::ZERO;
                     for (xt, wt) in rule.points() {
                         let (q, nq) = at(lo + half * (xt + T::ONE));
+                        tick();
                         piece += wt * kernel_unoccluded(p, np, q, nq);
                     }
                     line += piece * half;
@@ -130,7 +151,7 @@ where
     if !value.is_finite() || value < T::ZERO {
         return Err(PdmError::InvalidResult);
     }
-    Ok(value)
+    Ok((value, count.get()))
 }
 
 /// Appends to `out` every point of (lo, hi) where `f` changes value, found on a uniform grid of

@@ -38,9 +38,11 @@
 )]
 #![cfg_attr(test, allow(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing))]
 
+pub mod adaptive;
 pub mod boundary;
 pub mod dual;
 pub mod error;
+pub mod fixed;
 pub mod form_factor;
 pub mod gauss;
 mod math;
@@ -57,7 +59,8 @@ pub use dual::{Dual, Scalar};
 pub use error::PdmError;
 pub use form_factor::{exchange, form_factor, form_factor_between, self_form_factor, surface_form_factor, Quadrature};
 pub use gauss::{GaussRule, MAX_ORDER};
-pub use boundary::boundary_exchange;
+pub use adaptive::{adaptive_exchange, Adaptive, Estimate};
+pub use boundary::{boundary_exchange, boundary_exchange_counted};
 pub use pair::{pair_exchange, PairSettings};
 pub use patch::{Patch, PatchGrid};
 pub use real::Real;

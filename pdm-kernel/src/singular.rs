@@ -150,8 +150,11 @@ where
 }
 
 /// Relative gap below which a pair that does not touch is still integrated with the touching
-/// transforms (graded towards the gap): 1 % of the patch size.
-pub const NEAR_CONTACT: f64 = 1e-2;
+/// transforms (graded towards the gap): 2 % of the patch size. The transforms are exact changes
+/// of variables for any pair; they pay off when the near-singularity sits at the pyramids' apex,
+/// i.e. when the matched edge or corner is where the patches come closest — true for small gaps,
+/// not for e.g. two parallel patches facing each other at a distance comparable to their size.
+pub const NEAR_CONTACT: f64 = 0.02;
 
 /// Like [`classify`], but corners closer than [`NEAR_CONTACT`] × size also count as shared;
 /// returns the adjacency and the gap (largest distance between matched points, relative to the
@@ -163,7 +166,16 @@ where
     SA: Surface<T> + ?Sized,
     SB: Surface<T> + ?Sized,
 {
+    let (exact, _) = contact(a, b, adjacency_tolerance::<T>());
+    if exact == Adjacency::Identical {
+        return (exact, T::ZERO);
+    }
     let (adjacency, gap) = contact(a, b, T::from_f64(NEAR_CONTACT));
+    if adjacency == Adjacency::Identical {
+        // Nearly coincident but not the same patch (e.g. two close parallel patches): no
+        // transform applies.
+        return (Adjacency::Separate, T::ZERO);
+    }
     // A gap at the level of rounding is no gap: grading for it would only cost time.
     let rounding = T::from_f64(64.0) * T::EPSILON;
     (adjacency, if gap > rounding { gap } else { T::ZERO })

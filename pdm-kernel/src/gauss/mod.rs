@@ -81,15 +81,24 @@ impl<T: Real> GaussRule<T> {
         const {
             assert!(MAX <= tables::MAX_ORDER, "MAX must not exceed MAX_ORDER");
         }
+        // One match per width over the orders up to MAX (the other arms are dead code the
+        // compiler drops, with their tables); the width is chosen once, outside the match.
         macro_rules! select {
-            ($($n:literal)*) => {
+            ($table:ident: $($n:literal)*) => {
                 match order {
-                    $($n if $n <= MAX => Ok(Self::fixed::<$n>()),)*
-                    _ => Err(PdmError::UnsupportedOrder { order }),
+                    $($n if $n <= MAX => tables::$table::<$n>(),)*
+                    _ => (&[], &[]),
                 }
             };
         }
-        select!(1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25 26 27 28 29 30 31 32)
+        let (nodes, weights) = of_width::<T>(
+            || select!(fixed_f32: 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25 26 27 28 29 30 31 32),
+            || select!(fixed_f64: 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25 26 27 28 29 30 31 32),
+        );
+        if nodes.is_empty() {
+            return Err(PdmError::UnsupportedOrder { order });
+        }
+        Ok(Self { nodes, weights })
     }
 
     /// Number of points n.
@@ -249,6 +258,37 @@ mod tests {
         assert!(matches!(GaussRule::<f64>::new(0), Err(PdmError::UnsupportedOrder { order: 0 })));
         assert!(GaussRule::<f32>::new(MAX_ORDER + 1).is_err());
         assert!(GaussRule::<f64>::new(usize::MAX).is_err());
+    }
+    /// Same bits whichever constructor builds the rule, for every order and both widths.
+    fn constructors_agree<T: Real>() {
+        macro_rules! check {
+            ($($n:literal)*) => {$(
+                let by_order = GaussRule::<T>::new($n).unwrap();
+                for rule in [GaussRule::<T>::fixed::<$n>(), GaussRule::<T>::new_up_to::<MAX_ORDER>($n).unwrap()] {
+                    assert_eq!(rule.order(), $n);
+                    assert!(core::ptr::eq(rule.nodes(), by_order.nodes()), "order {}: other nodes", $n);
+                    assert!(core::ptr::eq(rule.weights(), by_order.weights()), "order {}: other weights", $n);
+                }
+            )*};
+        }
+        check!(1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25 26 27 28 29 30 31 32);
+        assert_eq!(MAX_ORDER, 32);
+        for n in 0..=MAX_ORDER + 1 {
+            let bounded = GaussRule::<T>::new_up_to::<5>(n);
+            if (1..=5).contains(&n) {
+                assert_eq!(bounded.unwrap().nodes(), GaussRule::<T>::new(n).unwrap().nodes());
+            } else {
+                assert!(matches!(bounded, Err(PdmError::UnsupportedOrder { order }) if order == n));
+            }
+        }
+    }
+    #[test]
+    fn constructors_agree_f32() {
+        constructors_agree::<f32>();
+    }
+    #[test]
+    fn constructors_agree_f64() {
+        constructors_agree::<f64>();
     }
     #[test]
     fn integrate_maps_interval() {

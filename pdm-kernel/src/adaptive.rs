@@ -1,0 +1,280 @@
+//! Tolerance-driven integration: spend effort only where a pair of patches needs it.
+//!
+//! [`adaptive_exchange`] returns A_a·F_{a→b} with an error estimate and the number of integrand
+//! evaluations it took. Per pair it
+//! 1. classifies the pair ([`classify_near`]): touching pairs use the regularising transforms,
+//!    raising the order by 2 until two successive results agree to the tolerance;
+//! 2. for separate pairs, starts from an order chosen from the geometry — the Gauss error on an
+//!    integrand whose nearest singularity lies at distance d from patches of size h falls like
+//!    ρ^(−2p) with ρ ≈ 1 + 2d/h, so p₀ = ⌈ln(1/tol) / (2 ln ρ)⌉ (clamped to 2…12);
+//! 3. skips the occlusion tests when no occluder can cut a segment between the two patches'
+//!    bounding balls (`Occluder::may_block_between`), and places visibility boundaries into the
+//!    rule ([`boundary`](crate::boundary)) only when the pair straddles one (some sample pairs
+//!    visible, some not, or an occluder that may cut);
+//! 4. compares orders p and p + 2; if they disagree by more than the tolerance after
+//!    `max_order`, splits the larger patch in two across its longer side and recurses
+//!    (depth ≤ `max_depth`, so at most 2^max_depth leaf pairs; no allocation).
+//!
+//! The error estimate is the difference between the last two orders (or the sum over the
+//! children's estimates). For exponentially converging integrands it bounds the error of the
+//! higher order, typically by a wide margin; it is checked against exact values in the tests.
+
+use crate::boundary::boundary_exchange_counted;
+use crate::error::PdmError;
+use crate::form_factor::exchange;
+use crate::patch::Patch;
+use crate::real::Real;
+use crate::samples::PatchSamples;
+use crate::singular::{classify_near, touching_exchange, Adjacency};
+use crate::surface::{ParamRect, Surface};
+use crate::visibility::Occluder;
+
+/// Settings of the tolerance-driven mode.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Adaptive<T> {
+    /// Relative tolerance on each pair's exchange A_a·F_{a→b}.
+    pub tolerance: T,
+    /// Largest Gauss order before a pair is subdivided instead.
+    pub max_order: usize,
+    /// Largest number of successive halvings of a pair (≤ 2^max_depth leaf pairs).
+    pub max_depth: u32,
+}
+
+impl<T: Real> Adaptive<T> {
+    /// `tolerance` with max order 12 and max depth 6.
+    #[must_use]
+    pub fn new(tolerance: T) -> Self {
+        Self { tolerance, max_order: 12, max_depth: 6 }
+    }
+}
+
+/// A value with its error estimate and cost.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Estimate<T> {
+    /// The value (A_a·F_{a→b} for [`adaptive_exchange`]).
+    pub value: T,
+    /// Estimated absolute error of `value`.
+    pub error: T,
+    /// Integrand evaluations spent (kernel evaluations and visibility probes).
+    pub evaluations: u64,
+}
+
+/// A_a·F_{a→b} to relative tolerance `settings.tolerance` (see the module docs). `CAP` ≥
+/// (`max_order` + 2)².
+pub fn adaptive_exchange<T, SA, SB, O, const CAP: usize>(
+    a: &Patch<'_, T, SA>,
+    b: &Patch<'_, T, SB>,
+    settings: Adaptive<T>,
+    occluders: &O,
+) -> Result<Estimate<T>, PdmError>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
+    if !(settings.tolerance > T::ZERO) || !settings.tolerance.is_finite() {
+        return Err(PdmError::NonFinite);
+    }
+    recurse::<T, SA, SB, O, CAP>(a, b, settings, occluders, 0)
+}
+
+fn recurse<T, SA, SB, O, const CAP: usize>(
+    a: &Patch<'_, T, SA>,
+    b: &Patch<'_, T, SB>,
+    settings: Adaptive<T>,
+    occluders: &O,
+    depth: u32,
+) -> Result<Estimate<T>, PdmError>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
+    let tol = settings.tolerance;
+    let (adjacency, gap) = classify_near(a, b);
+    match adjacency {
+        Adjacency::SharedEdge { .. } | Adjacency::SharedVertex { .. } => {
+            let per_order = |p: usize| -> u64 {
+                let p4 = (p as u64).pow(4);
+                if matches!(adjacency, Adjacency::SharedEdge { .. }) { 12 * p4 } else { 4 * p4 }
+            };
+            let mut p = 6;
+            let mut evaluations = per_order(p);
+            let mut prev = touching_exchange(a, b, adjacency, gap, p, occluders)?;
+            loop {
+                let next_p = p + 2;
+                let next = touching_exchange(a, b, adjacency, gap, next_p, occluders)?;
+                evaluations += per_order(next_p);
+                let error = (next - prev).abs();
+                if error <= tol * next.abs() {
+                    return Ok(Estimate { value: next, error, evaluations });
+                }
+                if next_p + 2 > settings.max_order.max(8) {
+                    if depth >= settings.max_depth {
+                        return Ok(Estimate { value: next, error, evaluations });
+                    }
+                    return split::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, evaluations);
+                }
+                prev = next;
+                p = next_p;
+            }
+        }
+        Adjacency::Identical => {
+            let p = settings.max_order.min(crate::gauss::MAX_ORDER - 1);
+            let lo = crate::form_factor::self_form_factor::<T, SA, O, CAP>(a, p.saturating_sub(2).max(1), occluders)?;
+            let hi = crate::form_factor::self_form_factor::<T, SA, O, CAP>(a, p, occluders)?;
+            let area = PatchSamples::<T, CAP>::new(a, p)?.area();
+            let evaluations = ((p * (p + 1)) as u64).pow(2) * 2;
+            Ok(Estimate { value: hi * area, error: (hi - lo).abs() * area, evaluations })
+        }
+        Adjacency::Separate => separate::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth),
+    }
+}
+
+fn separate<T, SA, SB, O, const CAP: usize>(
+    a: &Patch<'_, T, SA>,
+    b: &Patch<'_, T, SB>,
+    settings: Adaptive<T>,
+    occluders: &O,
+    depth: u32,
+) -> Result<Estimate<T>, PdmError>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
+    let tol = settings.tolerance;
+    // Starting order from the geometry.
+    let probe = PatchSamples::<T, CAP>::new(a, 2)?;
+    let probe_b = PatchSamples::<T, CAP>::new(b, 2)?;
+    let (ba, bb) = (probe.bounds(), probe_b.bounds());
+    let size = (ba.radius + bb.radius).max(T::MIN_POSITIVE);
+    let dist = ((ba.center - bb.center).norm() - ba.radius - bb.radius).max(T::ZERO);
+    let rho = T::ONE + T::TWO * dist / size;
+    let digits = (T::ONE / tol).ln();
+    // Smallest p in 2..=12 with ρ^(2p) ≥ 1/tol, i.e. 2p·ln ρ ≥ ln(1/tol).
+    let ln_rho = rho.ln();
+    let mut p: usize = 2;
+    while p < 12 && !(T::from_usize(2 * p) * ln_rho >= digits) {
+        p += 1;
+    }
+    let max_order = settings.max_order.clamp(6, crate::gauss::MAX_ORDER - 2);
+    p = p.min(max_order);
+
+    let mut evaluations = 0u64;
+    let sa = PatchSamples::<T, CAP>::new(a, p)?;
+    let sb = PatchSamples::<T, CAP>::new(b, p)?;
+    let may_occlude = occluders.may_block_between(&sa.bounds(), &sb.bounds());
+    let boundaries = may_occlude || straddles_curvature_cut(&sa, &sb);
+    // Below order 4 (6 with boundaries) two successive orders can agree by accident; start there.
+    p = p.max(if boundaries { 6 } else { 4 }).min(max_order - 2);
+    let eval = |order: usize| -> Result<(T, u64), PdmError> {
+        if boundaries {
+            boundary_exchange_counted::<T, SA, SB, O, CAP>(a, b, order, occluders)
+        } else {
+            let sa = PatchSamples::<T, CAP>::new(a, order)?;
+            let sb = PatchSamples::<T, CAP>::new(b, order)?;
+            Ok((exchange(&sa, &sb, occluders)?, (sa.len() * sb.len()) as u64))
+        }
+    };
+    let (mut prev, n0) = eval(p)?;
+    evaluations += n0;
+    loop {
+        let next_p = p + 2;
+        let (next, n) = eval(next_p)?;
+        evaluations += n;
+        let error = (next - prev).abs();
+        if error <= tol * next.abs() || (error <= T::MIN_POSITIVE) {
+            return Ok(Estimate { value: next, error, evaluations });
+        }
+        if next_p + 2 > max_order {
+            if depth >= settings.max_depth {
+                return Ok(Estimate { value: next, error, evaluations });
+            }
+            return split::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, evaluations);
+        }
+        prev = next;
+        p = next_p;
+    }
+}
+
+/// Splits the larger patch (by the extent of its image) in two across its longer side and
+/// recurses on both halves; `spent` evaluations are carried into the total.
+fn split<T, SA, SB, O, const CAP: usize>(
+    a: &Patch<'_, T, SA>,
+    b: &Patch<'_, T, SB>,
+    settings: Adaptive<T>,
+    occluders: &O,
+    depth: u32,
+    spent: u64,
+) -> Result<Estimate<T>, PdmError>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
+    let mut total = Estimate { value: T::ZERO, error: T::ZERO, evaluations: spent };
+    let split_a = extent(a) >= extent(b);
+    for half in 0..2 {
+        let e = if split_a {
+            let Some(ca) = half_patch(a, half) else { return Err(PdmError::Degenerate) };
+            recurse::<T, SA, SB, O, CAP>(&ca, b, settings, occluders, depth + 1)?
+        } else {
+            let Some(cb) = half_patch(b, half) else { return Err(PdmError::Degenerate) };
+            recurse::<T, SA, SB, O, CAP>(a, &cb, settings, occluders, depth + 1)?
+        };
+        total.value += e.value;
+        total.error += e.error;
+        total.evaluations = total.evaluations.saturating_add(e.evaluations);
+    }
+    Ok(total)
+}
+
+/// Largest distance between the corners of a patch's image.
+fn extent<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>) -> T {
+    let r = p.rect();
+    let g = p.surface();
+    let c = [g.point(r.t0, r.s0), g.point(r.t1, r.s0), g.point(r.t0, r.s1), g.point(r.t1, r.s1)];
+    let mut m = T::ZERO;
+    for x in &c {
+        for y in &c {
+            m = m.max((*x - *y).norm());
+        }
+    }
+    m
+}
+
+/// Half `k` (0 or 1) of a patch, split across the parameter direction whose image is longer.
+fn half_patch<'s, T: Real, S: Surface<T> + ?Sized>(p: &Patch<'s, T, S>, k: usize) -> Option<Patch<'s, T, S>> {
+    let r: ParamRect<T> = p.rect();
+    let g = p.surface();
+    let (tm, sm) = ((r.t0 + r.t1) * T::HALF, (r.s0 + r.s1) * T::HALF);
+    let along_t = (g.point(r.t1, sm) - g.point(r.t0, sm)).norm();
+    let along_s = (g.point(tm, r.s1) - g.point(tm, r.s0)).norm();
+    let cell = if along_t >= along_s { r.cell(k, 0, 2, 1) } else { r.cell(0, k, 1, 2) };
+    Patch::new(g, cell).ok()
+}
+
+/// `true` if some sample pairs pass the two-sided curvature test and others do not.
+fn straddles_curvature_cut<T: Real, const CA: usize, const CB: usize>(a: &PatchSamples<T, CA>, b: &PatchSamples<T, CB>) -> bool {
+    let mut seen_visible = false;
+    let mut seen_hidden = false;
+    for sa in a.iter() {
+        for sb in b.iter() {
+            let e = sb.point - sa.point;
+            let visible = sa.unit_normal.dot(e) > T::ZERO && sb.unit_normal.dot(e) < T::ZERO;
+            seen_visible |= visible;
+            seen_hidden |= !visible;
+            if seen_visible && seen_hidden {
+                return true;
+            }
+        }
+    }
+    false
+}
