@@ -3,3 +3,4 @@
 
 pub mod gauss_gen;
 pub mod reference;
+pub mod validate;

@@ -1,2 +1,7 @@
-//! The `pdm` command line.
-fn main() {}
+//! The `pdm` command line. `pdm validate --help` for the paper's validation.
+
+mod cli;
+
+fn main() -> std::process::ExitCode {
+    cli::main()
+}

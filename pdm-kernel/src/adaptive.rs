@@ -262,7 +262,7 @@ fn half_patch<'s, T: Real, S: Surface<T> + ?Sized>(p: &Patch<'s, T, S>, k: usize
 }
 
 /// `true` if some sample pairs pass the two-sided curvature test and others do not.
-fn straddles_curvature_cut<T: Real, const CA: usize, const CB: usize>(a: &PatchSamples<T, CA>, b: &PatchSamples<T, CB>) -> bool {
+pub(crate) fn straddles_curvature_cut<T: Real, const CA: usize, const CB: usize>(a: &PatchSamples<T, CA>, b: &PatchSamples<T, CB>) -> bool {
     let mut seen_visible = false;
     let mut seen_hidden = false;
     for sa in a.iter() {

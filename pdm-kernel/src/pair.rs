@@ -4,10 +4,12 @@
 //!   when they are only nearly touching) use the regularising
 //!   transforms of [`crate::singular`], converging exponentially with `singular_order`.
 //! - The same patch twice uses the interlaced-order self integral ([`crate::self_form_factor`]).
-//! - Separate pairs use the PDM sum at `order`, with the visibility boundaries (back-face cut
-//!   and occluder shadows) placed into the inner rule when `boundaries` is on
-//!   ([`crate::boundary`]).
+//! - Separate pairs use the PDM sum at `order`. With `boundaries` on, a pair that straddles a
+//!   back-face cut or that an occluder may cut gets the visibility boundaries placed into the
+//!   inner rule ([`crate::boundary`]; the outer patch is also split 2 × 2 when an occluder may
+//!   cut); smooth, unoccludable pairs keep the plain sum.
 
+use crate::adaptive::straddles_curvature_cut;
 use crate::boundary::boundary_exchange;
 use crate::error::PdmError;
 use crate::form_factor::exchange;
@@ -61,12 +63,28 @@ where
             Ok(f * sa.area())
         }
         Adjacency::Separate => {
-            if settings.boundaries {
-                boundary_exchange::<T, SA, SB, O, CAP>(a, b, settings.order, occluders)
+            let sa = PatchSamples::<T, CAP>::new(a, settings.order)?;
+            let sb = PatchSamples::<T, CAP>::new(b, settings.order)?;
+            if !settings.boundaries {
+                return exchange(&sa, &sb, occluders);
+            }
+            let may_occlude = occluders.may_block_between(&sa.bounds(), &sb.bounds());
+            if may_occlude {
+                // Shadow edges crossing b make the outer integrand kink where they touch b's
+                // edges; splitting the outer patch 2 × 2 keeps those kinks near cell edges
+                // (≈ 5× better at 4× the cost on the paper's cube, measured).
+                let mut total = T::ZERO;
+                let r = a.rect();
+                for k in 0..4 {
+                    let child = Patch::new(a.surface(), r.cell(k / 2, k % 2, 2, 2))?;
+                    total += boundary_exchange::<T, SA, SB, O, CAP>(&child, b, settings.order, occluders)?;
+                }
+                Ok(total)
+            } else if straddles_curvature_cut(&sa, &sb) {
+                boundary_exchange::<T, SA, SB, (), CAP>(a, b, settings.order, &())
             } else {
-                let sa = PatchSamples::<T, CAP>::new(a, settings.order)?;
-                let sb = PatchSamples::<T, CAP>::new(b, settings.order)?;
-                exchange(&sa, &sb, occluders)
+                // Smooth pair: nothing to place into the rule, no occluder can cut it.
+                exchange(&sa, &sb, &())
             }
         }
     }

@@ -1,0 +1,394 @@
+//! The two computations (`--mode paper` and `--mode accurate`), generic over the precision `T`
+//! and the sample capacity `CAP` (≥ order²), parallelised over outer patches with rayon (the
+//! kernel itself is single-threaded). Partial sums are collected in task order and added
+//! sequentially, so results do not depend on the number of threads.
+
+use std::time::Instant;
+
+use pdm_kernel::{
+    form_factor, pair_exchange, PairSettings, Parallelogram, Patch, PatchGrid, PatchSamples,
+    PdmError, Real, Sphere,
+};
+use rayon::prelude::*;
+
+use super::scene::{Scene, FACE_PAIRS};
+use super::{Mode, Progress, RunConfig, ValidateError};
+
+/// What one computation produced, in f64 (converted from `T` after all arithmetic in `T`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Values {
+    /// F sphere → face, faces 1..6 (eq. 25); `None` without a sphere.
+    pub sphere_to_face: Option<[f64; 6]>,
+    /// F face → sphere by reciprocity, A_s F_s→f / A_f with the same rule's areas.
+    pub face_to_sphere: Option<[f64; 6]>,
+    /// F a → b for the 15 pairs of [`FACE_PAIRS`] (eq. 26).
+    pub face_to_face: [f64; 15],
+    /// Σ_b F a → b + F a → sphere, faces 1..6 (F b → a for b < a by reciprocity).
+    pub face_sum: [f64; 6],
+    /// Σ of the sphere patch areas by eq. (12) with the run's rule.
+    pub sphere_area: Option<f64>,
+    /// Face areas (Σ of the patch areas by eq. 12).
+    pub face_area: [f64; 6],
+}
+
+/// Wall times of one computation, seconds.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Times {
+    /// Sphere → face part (sampling included).
+    pub sphere_face: f64,
+    /// Face → face part (sampling included).
+    pub face_face: f64,
+}
+
+type Face<T> = Parallelogram<T>;
+
+fn kernel(context: &'static str) -> impl Fn(PdmError) -> ValidateError {
+    move |error| ValidateError::Kernel { context, error }
+}
+
+/// Units of progress one computation reports (one per outer patch).
+#[must_use]
+pub fn work_units(cfg: &RunConfig) -> u64 {
+    let face_patches = cfg.face_grid * cfg.face_grid;
+    let sphere = if cfg.radius > 0.0 {
+        6 * cfg.sphere_grid.0 * cfg.sphere_grid.1
+    } else {
+        0
+    };
+    (sphere + FACE_PAIRS.len() * face_patches) as u64
+}
+
+/// One full computation (both parts) in precision `T` with sample capacity `CAP`.
+pub fn run_once<T: Real, const CAP: usize>(
+    cfg: &RunConfig,
+    progress: &dyn Progress,
+) -> Result<(Values, Times), ValidateError> {
+    let scene = Scene::<T>::new(cfg.radius).map_err(kernel("building the scene"))?;
+    let k = cfg.face_grid;
+    let mut face_patches: Vec<Vec<Patch<'_, T, Face<T>>>> = Vec::with_capacity(6);
+    for face in &scene.faces {
+        face_patches.push(
+            PatchGrid::new(face, k, k)
+                .map_err(kernel("face grid"))?
+                .collect(),
+        );
+    }
+
+    // Part 1: sphere → face (Table 1), eq. (25).
+    let start = Instant::now();
+    let part1 = match &scene.sphere {
+        Some(sphere) => {
+            progress.stage("sphere -> face");
+            let (m, n) = cfg.sphere_grid;
+            let sphere_patches: Vec<Patch<'_, T, Sphere<T>>> = PatchGrid::new(sphere, m, n)
+                .map_err(kernel("sphere grid"))?
+                .collect();
+            Some(match cfg.mode {
+                Mode::Paper => {
+                    paper_sphere_face::<T, CAP>(cfg, &sphere_patches, &face_patches, progress)?
+                }
+                Mode::Accurate => {
+                    accurate_sphere_face::<T, CAP>(cfg, &sphere_patches, &face_patches, progress)?
+                }
+            })
+        }
+        None => None,
+    };
+    let sphere_face_seconds = start.elapsed().as_secs_f64();
+
+    // Part 2: face → face (Table 3), eq. (26), the sphere as occluder.
+    progress.stage("face -> face");
+    let start = Instant::now();
+    let (face_exchange, face_area) = match cfg.mode {
+        Mode::Paper => paper_face_face::<T, CAP>(cfg, &scene.sphere, &face_patches, progress)?,
+        Mode::Accurate => {
+            accurate_face_face::<T, CAP>(cfg, &scene.sphere, &face_patches, progress)?
+        }
+    };
+    let face_face_seconds = start.elapsed().as_secs_f64();
+
+    let values = derive(part1, &face_exchange, &face_area)?;
+    Ok((
+        values,
+        Times {
+            sphere_face: sphere_face_seconds,
+            face_face: face_face_seconds,
+        },
+    ))
+}
+
+/// Exchange sums per face (Σ A_ps F_ps→pf over the face's patches) and the sphere's area.
+struct SpherePart<T> {
+    exchange: [T; 6],
+    sphere_area: T,
+    face_area: [T; 6],
+}
+
+/// F values from the exchange sums and areas, all in `T`.
+fn derive<T: Real>(
+    part1: Option<SpherePart<T>>,
+    face_exchange: &[T; 15],
+    face_area: &[T; 6],
+) -> Result<Values, ValidateError> {
+    let area_of = |f: usize| face_area.get(f.wrapping_sub(1)).copied().unwrap_or(T::ZERO);
+    let mut face_to_face = [0.0; 15];
+    let mut sums = [T::ZERO; 6];
+    for ((&(a, b), &e), out) in FACE_PAIRS
+        .iter()
+        .zip(face_exchange)
+        .zip(face_to_face.iter_mut())
+    {
+        *out = (e / area_of(a)).to_f64();
+        if let Some(s) = sums.get_mut(a - 1) {
+            *s += e / area_of(a);
+        }
+        if let Some(s) = sums.get_mut(b - 1) {
+            *s += e / area_of(b);
+        }
+    }
+    let (sphere_to_face, face_to_sphere, sphere_area) = match part1 {
+        Some(p) => {
+            let mut s2f = [0.0; 6];
+            let mut f2s = [0.0; 6];
+            for (f, &e) in p.exchange.iter().enumerate() {
+                let fa = p.face_area.get(f).copied().unwrap_or(T::ZERO);
+                let to_sphere = e / fa;
+                if let (Some(x), Some(y), Some(s)) =
+                    (s2f.get_mut(f), f2s.get_mut(f), sums.get_mut(f))
+                {
+                    *x = (e / p.sphere_area).to_f64();
+                    *y = to_sphere.to_f64();
+                    *s += to_sphere;
+                }
+            }
+            (Some(s2f), Some(f2s), Some(p.sphere_area.to_f64()))
+        }
+        None => (None, None, None),
+    };
+    let face_sum = sums.map(Real::to_f64);
+    let all = face_to_face
+        .iter()
+        .chain(&face_sum)
+        .chain(sphere_to_face.iter().flatten());
+    if all.clone().any(|x| !x.is_finite()) {
+        return Err(ValidateError::Kernel {
+            context: "summing the patch factors",
+            error: PdmError::InvalidResult,
+        });
+    }
+    Ok(Values {
+        sphere_to_face,
+        face_to_sphere,
+        face_to_face,
+        face_sum,
+        sphere_area,
+        face_area: face_area.map(Real::to_f64),
+    })
+}
+
+/// Adds task results (in task order) in consecutive chunks of `chunk`: one total per chunk.
+fn chunk_sums<T: Real, const N: usize>(partial: &[T], chunk: usize) -> [T; N] {
+    let mut out = [T::ZERO; N];
+    for (o, c) in out.iter_mut().zip(partial.chunks(chunk.max(1))) {
+        let mut s = T::ZERO;
+        for &x in c {
+            s += x;
+        }
+        *o = s;
+    }
+    out
+}
+
+fn sample_all<T: Real, S: pdm_kernel::Surface<T> + Sync + ?Sized, const CAP: usize>(
+    patches: &[Patch<'_, T, S>],
+    order: usize,
+) -> Result<Vec<PatchSamples<T, CAP>>, ValidateError> {
+    patches
+        .par_iter()
+        .map(|p| PatchSamples::<T, CAP>::new(p, order).map_err(kernel("sampling a patch")))
+        .collect()
+}
+
+fn total_area<T: Real, const CAP: usize>(samples: &[PatchSamples<T, CAP>]) -> T {
+    let mut a = T::ZERO;
+    for s in samples {
+        a += s.area();
+    }
+    a
+}
+
+/// Paper mode, part 1: eq. (25) with plain eq. (16) sums on precomputed samples, no occluder
+/// (the sphere is convex: the curvature test is its only visibility test against the faces).
+fn paper_sphere_face<T: Real, const CAP: usize>(
+    cfg: &RunConfig,
+    sphere_patches: &[Patch<'_, T, Sphere<T>>],
+    face_patches: &[Vec<Patch<'_, T, Face<T>>>],
+    progress: &dyn Progress,
+) -> Result<SpherePart<T>, ValidateError> {
+    let ss = sample_all::<T, Sphere<T>, CAP>(sphere_patches, cfg.order)?;
+    let fs = face_patches
+        .iter()
+        .map(|f| sample_all::<T, Face<T>, CAP>(f, cfg.order))
+        .collect::<Result<Vec<_>, _>>()?;
+    let tasks: Vec<(&PatchSamples<T, CAP>, &[PatchSamples<T, CAP>])> = fs
+        .iter()
+        .flat_map(|face| ss.iter().map(move |s| (s, face.as_slice())))
+        .collect();
+    let partial = tasks
+        .par_iter()
+        .map(|&(sa, face)| {
+            let mut acc = T::ZERO;
+            for sb in face {
+                // Eq. (25): A_ps · F_ps→pf.
+                acc += form_factor(sa, sb, &()).map_err(kernel("sphere patch -> face patch"))?
+                    * sa.area();
+            }
+            progress.advance(1);
+            Ok(acc)
+        })
+        .collect::<Result<Vec<T>, ValidateError>>()?;
+    let mut face_area = [T::ZERO; 6];
+    for (a, f) in face_area.iter_mut().zip(&fs) {
+        *a = total_area(f);
+    }
+    Ok(SpherePart {
+        exchange: chunk_sums(&partial, ss.len()),
+        sphere_area: total_area(&ss),
+        face_area,
+    })
+}
+
+/// Paper mode, part 2: eq. (26) with plain eq. (16) sums, the sphere as occluder; edge-adjacent
+/// patch pairs get the plain sum too (Gauss nodes are interior, so L never vanishes and the
+/// paper's L'Hôpital correction never triggers).
+fn paper_face_face<T: Real, const CAP: usize>(
+    cfg: &RunConfig,
+    sphere: &Option<Sphere<T>>,
+    face_patches: &[Vec<Patch<'_, T, Face<T>>>],
+    progress: &dyn Progress,
+) -> Result<([T; 15], [T; 6]), ValidateError> {
+    let fs = face_patches
+        .iter()
+        .map(|f| sample_all::<T, Face<T>, CAP>(f, cfg.order))
+        .collect::<Result<Vec<_>, _>>()?;
+    let per_pair = cfg.face_grid * cfg.face_grid;
+    let mut tasks: Vec<(&PatchSamples<T, CAP>, &[PatchSamples<T, CAP>])> = Vec::new();
+    for &(a, b) in &FACE_PAIRS {
+        if let (Some(fa), Some(fb)) = (fs.get(a - 1), fs.get(b - 1)) {
+            tasks.extend(fa.iter().map(|s| (s, fb.as_slice())));
+        }
+    }
+    let partial = tasks
+        .par_iter()
+        .map(|&(sa, face_b)| {
+            let mut acc = T::ZERO;
+            for sb in face_b {
+                acc += form_factor(sa, sb, sphere).map_err(kernel("face patch -> face patch"))?
+                    * sa.area();
+            }
+            progress.advance(1);
+            Ok(acc)
+        })
+        .collect::<Result<Vec<T>, ValidateError>>()?;
+    let mut face_area = [T::ZERO; 6];
+    for (a, f) in face_area.iter_mut().zip(&fs) {
+        *a = total_area(f);
+    }
+    Ok((chunk_sums(&partial, per_pair), face_area))
+}
+
+fn settings(cfg: &RunConfig) -> PairSettings {
+    PairSettings {
+        order: cfg.order,
+        singular_order: cfg.singular_order,
+        boundaries: true,
+    }
+}
+
+fn areas<T: Real, S: pdm_kernel::Surface<T> + Sync + ?Sized>(
+    patches: &[Patch<'_, T, S>],
+    order: usize,
+) -> Result<T, ValidateError> {
+    let each = patches
+        .par_iter()
+        .map(|p| p.area(order).map_err(kernel("patch area")))
+        .collect::<Result<Vec<T>, _>>()?;
+    let mut a = T::ZERO;
+    for x in each {
+        a += x;
+    }
+    Ok(a)
+}
+
+/// Accurate mode, part 1: [`pair_exchange`] (visibility boundaries in the rule) for every
+/// sphere patch × face patch; no occluder (the convex sphere is handled by the back-face cut).
+fn accurate_sphere_face<T: Real, const CAP: usize>(
+    cfg: &RunConfig,
+    sphere_patches: &[Patch<'_, T, Sphere<T>>],
+    face_patches: &[Vec<Patch<'_, T, Face<T>>>],
+    progress: &dyn Progress,
+) -> Result<SpherePart<T>, ValidateError> {
+    let set = settings(cfg);
+    type Task<'a, 'p, T> = (&'a Patch<'p, T, Sphere<T>>, &'a [Patch<'p, T, Face<T>>]);
+    let tasks: Vec<Task<'_, '_, T>> = face_patches
+        .iter()
+        .flat_map(|face| sphere_patches.iter().map(move |s| (s, face.as_slice())))
+        .collect();
+    let partial = tasks
+        .par_iter()
+        .map(|&(ps, face)| {
+            let mut acc = T::ZERO;
+            for pf in face {
+                acc += pair_exchange::<T, _, _, _, CAP>(ps, pf, set, &())
+                    .map_err(kernel("sphere patch -> face patch"))?;
+            }
+            progress.advance(1);
+            Ok(acc)
+        })
+        .collect::<Result<Vec<T>, ValidateError>>()?;
+    let mut face_area = [T::ZERO; 6];
+    for (a, f) in face_area.iter_mut().zip(face_patches) {
+        *a = areas(f, cfg.order)?;
+    }
+    Ok(SpherePart {
+        exchange: chunk_sums(&partial, sphere_patches.len()),
+        sphere_area: areas(sphere_patches, cfg.order)?,
+        face_area,
+    })
+}
+
+/// Accurate mode, part 2: [`pair_exchange`] for every face patch pair (shared-edge and
+/// shared-vertex transforms, boundary-aware sums elsewhere), the sphere as occluder.
+fn accurate_face_face<T: Real, const CAP: usize>(
+    cfg: &RunConfig,
+    sphere: &Option<Sphere<T>>,
+    face_patches: &[Vec<Patch<'_, T, Face<T>>>],
+    progress: &dyn Progress,
+) -> Result<([T; 15], [T; 6]), ValidateError> {
+    let set = settings(cfg);
+    let per_pair = cfg.face_grid * cfg.face_grid;
+    type Task<'a, 'p, T> = (&'a Patch<'p, T, Face<T>>, &'a [Patch<'p, T, Face<T>>]);
+    let mut tasks: Vec<Task<'_, '_, T>> = Vec::new();
+    for &(a, b) in &FACE_PAIRS {
+        if let (Some(fa), Some(fb)) = (face_patches.get(a - 1), face_patches.get(b - 1)) {
+            tasks.extend(fa.iter().map(|p| (p, fb.as_slice())));
+        }
+    }
+    let partial = tasks
+        .par_iter()
+        .map(|&(pa, face_b)| {
+            let mut acc = T::ZERO;
+            for pb in face_b {
+                acc += pair_exchange::<T, _, _, _, CAP>(pa, pb, set, sphere)
+                    .map_err(kernel("face patch -> face patch"))?;
+            }
+            progress.advance(1);
+            Ok(acc)
+        })
+        .collect::<Result<Vec<T>, ValidateError>>()?;
+    let mut face_area = [T::ZERO; 6];
+    for (a, f) in face_area.iter_mut().zip(face_patches) {
+        *a = areas(f, cfg.order)?;
+    }
+    Ok((chunk_sums(&partial, per_pair), face_area))
+}

@@ -1,0 +1,216 @@
+//! The reference values `validate` compares with. Nothing here uses `pdm_kernel`.
+//!
+//! * sphere → face: exactly 1/6 (a centred sphere radiates uniformly; each face subtends 4π/6);
+//! * face → sphere: exactly 4πR²/(6·36) (reciprocity; π/54 for R = 1);
+//! * face → face, R = 0: exact, Howell's C-11 (opposite) and C-14 (adjacent) for squares of
+//!   side 6 (the unit-square values 0.1998248956983874 and 0.2000437760754032);
+//! * face → face, R > 0: [`crate::reference::cube`], a deterministic integration that shares no
+//!   code with the kernel's quadrature, with its error estimate;
+//! * face sums: exactly 1.
+
+use std::time::Instant;
+
+use super::scene::{is_opposite, FACE_PAIRS, SIDE};
+use super::ValidateError;
+use crate::reference::closed_form::{
+    cube_face_to_centred_sphere, parallel_rectangles, perpendicular_rectangles,
+};
+
+/// Where the face → face reference came from.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Source {
+    /// Closed forms C-11 and C-14 (empty cube).
+    ClosedForm,
+    /// `pdm_host::reference::cube` (sphere as occluder), computed now.
+    Independent,
+    /// `pdm_host::reference::cube` for R = 1, stored ([`STORED_R1`]).
+    Stored,
+    /// The independent reference could not be computed (why); its values are NaN.
+    Unavailable(String),
+}
+
+/// Reference values, in the shapes of [`super::Values`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Reference {
+    /// 1/6 for each face; `None` without a sphere.
+    pub sphere_to_face: Option<[f64; 6]>,
+    /// 4πR²/(6·36) for each face; `None` without a sphere.
+    pub face_to_sphere: Option<[f64; 6]>,
+    /// For the 15 pairs of [`FACE_PAIRS`].
+    pub face_to_face: [f64; 15],
+    /// Uncertainty (absolute) of each face → face value; 0 for closed forms.
+    pub face_to_face_uncertainty: [f64; 15],
+    /// 1 for each face.
+    pub face_sum: [f64; 6],
+    /// F between adjacent faces.
+    pub adjacent: f64,
+    /// F between opposite faces.
+    pub opposite: f64,
+    /// Absolute uncertainty of `adjacent`.
+    pub adjacent_uncertainty: f64,
+    /// Absolute uncertainty of `opposite`.
+    pub opposite_uncertainty: f64,
+    /// Where the face → face values came from.
+    pub source: Source,
+    /// Seconds spent computing the reference.
+    pub seconds: f64,
+}
+
+impl Reference {
+    /// 4·F_adj + F_opp + F_face→sphere − 1 (zero up to the reference's own error).
+    #[must_use]
+    pub fn sum_rule_residual(&self) -> f64 {
+        let to_sphere = self.face_to_sphere.map_or(0.0, |f| f[0]);
+        4.0 * self.adjacent + self.opposite + to_sphere - 1.0
+    }
+
+    /// One line saying what the face → face reference is.
+    #[must_use]
+    pub fn describe(&self) -> String {
+        match &self.source {
+            Source::ClosedForm => {
+                "face -> face: exact, Howell C-11 (opposite) and C-14 (adjacent)".into()
+            }
+            Source::Unavailable(why) => format!("face -> face: unavailable ({why})"),
+            Source::Independent | Source::Stored => format!(
+                "face -> face: independent host integration, pdm_host::reference::cube{}; \
+                 uncertainty {:.0e} (adjacent), {:.0e} (opposite)",
+                if self.source == Source::Stored {
+                    " (stored; --recompute-reference)"
+                } else {
+                    ""
+                },
+                self.adjacent_uncertainty,
+                self.opposite_uncertainty
+            ),
+        }
+    }
+}
+
+/// `cube_face_factors(6, 1)` (adjacent, opposite, their error estimates), stored because it
+/// takes ~15 s; `pdm validate --recompute-reference` recomputes it, and the unit test
+/// `stored_reference_matches_cube_module` checks it.
+pub const STORED_R1: (f64, f64, f64, f64) = (
+    0.19689310669889962,
+    0.1542499314674972,
+    6.736728653997264e-13,
+    1.7015955677669572e-11,
+);
+
+/// The independent obstructed face → face factors: (adjacent, opposite, their uncertainties),
+/// from [`crate::reference::cube::cube_face_factors`] (side 6).
+fn obstructed(radius: f64) -> Result<(f64, f64, f64, f64), ValidateError> {
+    let r = crate::reference::cube::cube_face_factors(SIDE, radius);
+    let all = [
+        r.f_adjacent,
+        r.f_opposite,
+        r.f_adjacent_error,
+        r.f_opposite_error,
+    ];
+    if all.iter().all(|x| x.is_finite()) {
+        Ok((
+            r.f_adjacent,
+            r.f_opposite,
+            r.f_adjacent_error,
+            r.f_opposite_error,
+        ))
+    } else {
+        Err(ValidateError::Reference(format!(
+            "pdm_host::reference::cube gave no value for R = {radius}"
+        )))
+    }
+}
+
+/// The reference values for a centred sphere of radius `radius` (0 = empty cube); for R = 1
+/// the stored [`STORED_R1`] unless `recompute`. Never fails: if the independent reference
+/// cannot be computed its values are NaN and `source` says why.
+#[must_use]
+pub fn compute(radius: f64, recompute: bool) -> Reference {
+    let start = Instant::now();
+    let (adjacent, opposite, adjacent_uncertainty, opposite_uncertainty, source) =
+        if radius == 1.0 && !recompute {
+            let (a, o, ua, uo) = STORED_R1;
+            (a, o, ua, uo, Source::Stored)
+        } else if radius > 0.0 {
+            match obstructed(radius) {
+                Ok((a, o, ua, uo)) => (a, o, ua, uo, Source::Independent),
+                Err(e) => (
+                    f64::NAN,
+                    f64::NAN,
+                    f64::NAN,
+                    f64::NAN,
+                    Source::Unavailable(e.to_string()),
+                ),
+            }
+        } else {
+            (
+                perpendicular_rectangles(SIDE, SIDE, SIDE),
+                parallel_rectangles(SIDE, SIDE, SIDE),
+                0.0,
+                0.0,
+                Source::ClosedForm,
+            )
+        };
+    let mut face_to_face = [0.0; 15];
+    let mut face_to_face_uncertainty = [0.0; 15];
+    for ((&(a, b), f), u) in FACE_PAIRS
+        .iter()
+        .zip(&mut face_to_face)
+        .zip(&mut face_to_face_uncertainty)
+    {
+        (*f, *u) = if is_opposite(a, b) {
+            (opposite, opposite_uncertainty)
+        } else {
+            (adjacent, adjacent_uncertainty)
+        };
+    }
+    let sphere = radius > 0.0;
+    Reference {
+        sphere_to_face: sphere.then_some([1.0 / 6.0; 6]),
+        face_to_sphere: sphere.then(|| [cube_face_to_centred_sphere(SIDE, radius); 6]),
+        face_to_face,
+        face_to_face_uncertainty,
+        face_sum: [1.0; 6],
+        adjacent,
+        opposite,
+        adjacent_uncertainty,
+        opposite_uncertainty,
+        source,
+        seconds: start.elapsed().as_secs_f64(),
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn empty_cube_reference_closes() {
+        let r = compute(0.0, false);
+        assert!((r.adjacent - 0.2000437760754032).abs() < 1e-15);
+        assert!((r.opposite - 0.1998248956983874).abs() < 1e-15);
+        assert!(
+            r.sum_rule_residual().abs() < 1e-14,
+            "{}",
+            r.sum_rule_residual()
+        );
+        assert!(r.sphere_to_face.is_none());
+    }
+
+    /// The stored R = 1 values are what the reference module computes (≈ 15 s).
+    #[test]
+    fn stored_reference_matches_cube_module() {
+        let fresh = compute(1.0, true);
+        let stored = compute(1.0, false);
+        assert_eq!(fresh.source, Source::Independent);
+        assert_eq!(stored.source, Source::Stored);
+        assert!((fresh.adjacent - stored.adjacent).abs() <= 1e-14 + stored.adjacent_uncertainty);
+        assert!((fresh.opposite - stored.opposite).abs() <= 1e-14 + stored.opposite_uncertainty);
+        assert!(
+            stored.sum_rule_residual().abs() < 1e-10,
+            "{}",
+            stored.sum_rule_residual()
+        );
+    }
+}

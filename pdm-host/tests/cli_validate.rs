@@ -1,0 +1,292 @@
+//! `pdm validate` end to end: the JSON contract, bad input, and real checks of the kernel
+//! (the empty cube against C-11/C-14, the paper's grid against 1/6).
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    clippy::indexing_slicing
+)]
+
+use std::process::{Command, Output};
+
+use serde_json::Value;
+
+const PAIRS: [&str; 15] = [
+    "1-2", "1-3", "1-4", "1-5", "1-6", "2-3", "2-4", "2-5", "2-6", "3-4", "3-5", "3-6", "4-5",
+    "4-6", "5-6",
+];
+const C11: f64 = 0.1998248956983874; // Howell C-11, unit squares at distance 1
+const C14: f64 = 0.2000437760754032; // Howell C-14, unit squares with a common edge
+
+fn pdm(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_pdm"))
+        .args(args)
+        .output()
+        .expect("run pdm")
+}
+
+fn validate_json(args: &[&str]) -> Value {
+    let mut all = vec!["validate", "--format", "json"];
+    all.extend_from_slice(args);
+    let out = pdm(&all);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "pdm {all:?} failed: {stderr}");
+    // Nothing but the JSON object on stdout.
+    serde_json::from_slice(&out.stdout)
+        .unwrap_or_else(|e| panic!("stdout is not one JSON value: {e}"))
+}
+
+fn numbers(v: &Value, n: usize) -> Vec<f64> {
+    let a = v.as_array().unwrap_or_else(|| panic!("not an array: {v}"));
+    assert_eq!(a.len(), n, "{v}");
+    a.iter()
+        .map(|x| x.as_f64().unwrap_or_else(|| panic!("not a number: {x}")))
+        .collect()
+}
+
+fn pair_numbers(v: &Value) -> Vec<f64> {
+    let o = v
+        .as_object()
+        .unwrap_or_else(|| panic!("not an object: {v}"));
+    assert_eq!(o.len(), 15, "{v}");
+    PAIRS
+        .iter()
+        .map(|k| {
+            o.get(*k)
+                .and_then(Value::as_f64)
+                .unwrap_or_else(|| panic!("no number at {k}: {v}"))
+        })
+        .collect()
+}
+
+fn is_opposite(pair: &str) -> bool {
+    matches!(pair, "1-6" | "2-3" | "4-5")
+}
+
+#[test]
+fn json_contract_small_grid() {
+    let j = validate_json(&[
+        "--sphere-grid",
+        "2x4",
+        "--face-grid",
+        "2",
+        "--order",
+        "3",
+        "--repeat",
+        "1",
+    ]);
+    let s2f = numbers(&j["sphere_to_face"], 6);
+    assert!(s2f.iter().all(|f| (f - 1.0 / 6.0).abs() < 0.05), "{s2f:?}");
+    let ff = pair_numbers(&j["face_to_face"]);
+    assert!(ff.iter().all(|f| *f > 0.1 && *f < 0.3), "{ff:?}");
+    numbers(&j["face_sum"], 6);
+    let r = &j["reference"];
+    assert_eq!(numbers(&r["sphere_to_face"], 6), vec![1.0 / 6.0; 6]);
+    assert_eq!(numbers(&r["face_sum"], 6), vec![1.0; 6]);
+    let f2s = numbers(&r["face_to_sphere"], 6);
+    assert!((f2s[0] - std::f64::consts::PI / 54.0).abs() < 1e-15);
+    let o = r["face_to_face"].as_object().unwrap();
+    assert_eq!(o.len(), 15);
+    assert!(PAIRS.iter().all(|k| o.contains_key(*k)));
+    // Settings.
+    assert_eq!(j["mode"], "paper");
+    assert_eq!(j["order"], 3);
+    assert_eq!(j["precision"], "f64");
+    assert_eq!(j["sphere_radius"], 1.0);
+    assert_eq!(j["face_grid"], 2);
+    assert_eq!(j["sphere_grid"], serde_json::json!([2, 4]));
+    assert_eq!(j["patches"], 8 + 6 * 4);
+    assert!(j["seconds"].as_f64().unwrap() >= 0.0);
+    assert!(j["paper"].is_null(), "not one of the paper's grids");
+}
+
+#[test]
+fn json_paper_grid_86_sphere_to_face_within_one_percent() {
+    let j = validate_json(&["--patches", "86", "--repeat", "1"]);
+    assert_eq!(j["patches"], 86);
+    assert_eq!(j["order"], 5);
+    assert_eq!(j["sphere_grid"], serde_json::json!([4, 8]));
+    let s2f = numbers(&j["sphere_to_face"], 6);
+    for (f, v) in s2f.iter().enumerate() {
+        println!("paper mode, 86 patches: sphere -> face {}: {v:.9e}", f + 1);
+        assert!((v - 1.0 / 6.0).abs() < 0.01 / 6.0, "face {}: {v}", f + 1);
+    }
+    // The paper's numbers are reported beside ours.
+    let paper = numbers(&j["paper"]["sphere_to_face"], 6);
+    assert_eq!(paper[0], 1.6735e-1);
+    assert_eq!(paper[1], 1.6693e-1);
+    assert_eq!(j["paper"]["face_to_face"]["1-2"], 2.0341e-1);
+}
+
+/// The empty cube in accurate mode: the shared-edge and shared-vertex transforms must give the
+/// closed forms to 1e-9, and each face's factors must sum to 1.
+#[test]
+fn empty_cube_accurate_matches_c11_c14() {
+    let j = validate_json(&[
+        "--sphere-radius",
+        "0",
+        "--mode",
+        "accurate",
+        "--face-grid",
+        "2",
+        "--order",
+        "10",
+    ]);
+    assert!(j["sphere_to_face"].is_null());
+    assert!(j["reference"]["sphere_to_face"].is_null());
+    let ff = pair_numbers(&j["face_to_face"]);
+    let reference = pair_numbers(&j["reference"]["face_to_face"]);
+    for ((pair, ours), re) in PAIRS.iter().zip(&ff).zip(&reference) {
+        let exact = if is_opposite(pair) { C11 } else { C14 };
+        assert!((re - exact).abs() < 1e-15, "{pair}: reference {re}");
+        assert!(
+            (ours - exact).abs() < 1e-9 * exact,
+            "{pair}: {ours} vs {exact}"
+        );
+    }
+    for (f, s) in numbers(&j["face_sum"], 6).iter().enumerate() {
+        assert!((s - 1.0).abs() < 1e-9, "face {} sums to {s}", f + 1);
+    }
+    assert_eq!(j["mode"], "accurate");
+    assert_eq!(j["sphere_radius"], 0.0);
+}
+
+#[test]
+fn both_precisions_nest_f32() {
+    let j = validate_json(&[
+        "--sphere-radius",
+        "0",
+        "--face-grid",
+        "2",
+        "--precision",
+        "both",
+        "--repeat",
+        "1",
+    ]);
+    assert_eq!(j["precision"], "f64");
+    assert_eq!(j["f32"]["precision"], "f32");
+    let a = pair_numbers(&j["face_to_face"]);
+    let b = pair_numbers(&j["f32"]["face_to_face"]);
+    for (x, y) in a.iter().zip(&b) {
+        assert!((x - y).abs() < 1e-5 * x, "f64 {x} vs f32 {y}");
+    }
+}
+
+#[test]
+fn table_fits_80_columns_and_csv_has_rows() {
+    for args in [
+        &["validate", "--patches", "86", "--repeat", "1"][..],
+        &[
+            "validate",
+            "--sphere-radius",
+            "0",
+            "--face-grid",
+            "2",
+            "--precision",
+            "both",
+            "--repeat",
+            "1",
+        ][..],
+    ] {
+        let out = pdm(args);
+        assert!(out.status.success());
+        let text = String::from_utf8(out.stdout).unwrap();
+        for line in text.lines() {
+            assert!(
+                line.chars().count() <= 80,
+                "{} columns: {line}",
+                line.chars().count()
+            );
+        }
+        assert!(
+            text.contains("Table 3") && text.contains("Table 4"),
+            "{text}"
+        );
+    }
+    let out = pdm(&[
+        "validate",
+        "--format",
+        "csv",
+        "--sphere-radius",
+        "0",
+        "--face-grid",
+        "2",
+        "--repeat",
+        "1",
+    ]);
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next(),
+        Some("table,item,precision,paper,ours,reference,relative_error,reference_uncertainty")
+    );
+    assert_eq!(
+        text.lines()
+            .filter(|l| l.starts_with("face_to_face,"))
+            .count(),
+        15
+    );
+    assert_eq!(
+        text.lines().filter(|l| l.starts_with("face_sum,")).count(),
+        6
+    );
+    assert!(text.lines().all(|l| l.split(',').count() == 8), "{text}");
+}
+
+/// Bad input: one line on stderr naming the value, a non-zero exit, no panic.
+#[test]
+fn bad_input_is_one_line_naming_the_value() {
+    let cases: &[(&[&str], &str)] = &[
+        (&["--sphere-radius", "3"], "3"),
+        (&["--sphere-radius", "-0.5"], "-0.5"),
+        (&["--sphere-radius", "nan"], "nan"),
+        (&["--sphere-radius", "abc"], "abc"),
+        (&["--order", "0"], "0"),
+        (&["--order", "99"], "99"),
+        (&["--order", "five"], "five"),
+        (&["--singular-order", "40"], "40"),
+        (&["--face-grid", "0"], "0"),
+        (&["--face-grid", "-2"], "-2"),
+        (&["--sphere-grid", "4x0"], "4x0"),
+        (&["--sphere-grid", "-4x8"], "-4x8"),
+        (&["--sphere-grid", "4by8"], "4by8"),
+        (&["--patches", "100"], "100"),
+        (&["--precision", "f16"], "f16"),
+        (&["--format", "xml"], "xml"),
+        (&["--mode", "fast"], "fast"),
+        (&["--repeat", "0"], "0"),
+        (&["--bogus"], "--bogus"),
+        (&["--patches", "86", "--face-grid", "4"], "--face-grid"),
+    ];
+    for (args, named) in cases {
+        let mut all = vec!["validate"];
+        all.extend_from_slice(args);
+        let out = pdm(&all);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{all:?} succeeded");
+        assert_eq!(out.status.code(), Some(2), "{all:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{all:?}: {stderr}");
+        let lines: Vec<&str> = stderr.lines().filter(|l| !l.trim().is_empty()).collect();
+        assert_eq!(lines.len(), 1, "{all:?}: not one line: {stderr}");
+        assert!(lines[0].starts_with("error:"), "{all:?}: {stderr}");
+        assert!(
+            lines[0].contains(named),
+            "{all:?}: does not name {named}: {stderr}"
+        );
+        assert!(out.stdout.is_empty(), "{all:?}: wrote to stdout");
+    }
+}
+
+#[test]
+fn help_and_no_subcommand() {
+    let out = pdm(&["validate", "--help"]);
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("--sphere-radius") && text.contains("--patches"),
+        "{text}"
+    );
+    let out = pdm(&[]);
+    assert!(!out.status.success());
+}
