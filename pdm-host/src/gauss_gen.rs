@@ -450,60 +450,139 @@ pub fn tables() -> Result<Tables, GenError> {
     Ok(t)
 }
 
+/// Names and formatting of one table width.
+struct Width {
+    /// `f64` or `f32`.
+    ty: &'static str,
+    /// `F64` or `F32` (suffix of the static names).
+    suffix: &'static str,
+    /// Hex digits of the bit pattern.
+    digits: usize,
+    /// The flat nodes of all orders, as bit patterns.
+    nodes: Vec<u64>,
+    /// The flat weights of all orders, as bit patterns.
+    weights: Vec<u64>,
+}
+
 /// The complete text of `pdm-kernel/src/gauss/tables.rs` for the given tables.
+///
+/// Layout: one `static` per order, width and kind (`NODES_5_F32: [f32; 5]`, `WEIGHTS_5_F32`, …), so
+/// that a build which names its order at compile time (`fixed_f32::<5>()`, used by the kernel's
+/// `GaussRule::fixed`) links that order's 2·n values only; `NODES_F32` etc. index the per-order
+/// statics by order (entry 0 is empty) for run-time orders (`GaussRule::new`), which link all of
+/// them.
 #[must_use]
 pub fn render(t: &Tables) -> String {
-    let mut s = String::with_capacity(4 * 40 * TABLE_LEN + 512);
+    let widths = [
+        Width {
+            ty: "f64",
+            suffix: "F64",
+            digits: 16,
+            nodes: t.nodes_f64.iter().map(|v| v.to_bits()).collect(),
+            weights: t.weights_f64.iter().map(|v| v.to_bits()).collect(),
+        },
+        Width {
+            ty: "f32",
+            suffix: "F32",
+            digits: 8,
+            nodes: t.nodes_f32.iter().map(|v| u64::from(v.to_bits())).collect(),
+            weights: t
+                .weights_f32
+                .iter()
+                .map(|v| u64::from(v.to_bits()))
+                .collect(),
+        },
+    ];
+    let orders = t.offsets.len().saturating_sub(2);
+    let mut s = String::with_capacity(4 * 40 * TABLE_LEN + 16 * 1024);
     // Writing to a String cannot fail.
     let _ = writeln!(s, "{HEADER}");
     let _ = writeln!(
         s,
         "#![allow(clippy::unreadable_literal, clippy::excessive_precision)]"
     );
-    let _ = writeln!(s, "pub(crate) const MAX_ORDER: usize = {MAX_ORDER};");
-    let offsets: Vec<String> = t.offsets.iter().map(ToString::to_string).collect();
     let _ = writeln!(
         s,
-        "pub(crate) const OFFSETS: [usize; {}] = [{}];",
-        t.offsets.len(),
-        offsets.join(", ")
+        "// One static per order, width and kind (nodes ascending; weights), so that a build naming its"
     );
     let _ = writeln!(
         s,
-        "pub(crate) static NODES_F64: [f64; {}] = [",
-        t.nodes_f64.len()
+        "// order at compile time (`fixed_f32::<N>()`) links only that order's values. `NODES_F32` etc."
     );
-    for v in &t.nodes_f64 {
-        let _ = writeln!(s, "    f64::from_bits(0x{:016x}),", v.to_bits());
+    let _ = writeln!(
+        s,
+        "// index them by order (entry 0 is empty) for run-time orders, which link every order."
+    );
+    let _ = writeln!(s, "pub(crate) const MAX_ORDER: usize = {orders};");
+    for w in &widths {
+        for kind in ["NODES", "WEIGHTS"] {
+            let _ = writeln!(
+                s,
+                "pub(crate) static {kind}_{}: [&[{}]; {}] = [",
+                w.suffix,
+                w.ty,
+                orders + 1
+            );
+            let _ = writeln!(s, "    &[],");
+            for n in 1..=orders {
+                let _ = writeln!(s, "    &{kind}_{n}_{},", w.suffix);
+            }
+            let _ = writeln!(s, "];");
+        }
     }
-    let _ = writeln!(s, "];");
-    let _ = writeln!(
-        s,
-        "pub(crate) static WEIGHTS_F64: [f64; {}] = [",
-        t.weights_f64.len()
-    );
-    for v in &t.weights_f64 {
-        let _ = writeln!(s, "    f64::from_bits(0x{:016x}),", v.to_bits());
+    for w in &widths {
+        let _ = writeln!(
+            s,
+            "/// Nodes and weights of order `N` in {}, referencing only that order's statics (empty",
+            w.ty
+        );
+        let _ = writeln!(s, "/// outside `1..=MAX_ORDER`).");
+        let _ = writeln!(s, "#[inline(always)]");
+        let _ = writeln!(
+            s,
+            "pub(crate) fn fixed_{}<const N: usize>() -> (&'static [{ty}], &'static [{ty}]) {{",
+            w.ty,
+            ty = w.ty
+        );
+        let _ = writeln!(s, "    match N {{");
+        for n in 1..=orders {
+            let _ = writeln!(
+                s,
+                "        {n} => (&NODES_{n}_{sx}, &WEIGHTS_{n}_{sx}),",
+                sx = w.suffix
+            );
+        }
+        let _ = writeln!(s, "        _ => (&[], &[]),");
+        let _ = writeln!(s, "    }}");
+        let _ = writeln!(s, "}}");
     }
-    let _ = writeln!(s, "];");
-    let _ = writeln!(
-        s,
-        "pub(crate) static NODES_F32: [f32; {}] = [",
-        t.nodes_f32.len()
-    );
-    for v in &t.nodes_f32 {
-        let _ = writeln!(s, "    f32::from_bits(0x{:08x}),", v.to_bits());
+    for w in &widths {
+        for n in 1..=orders {
+            let (a, b) = (
+                t.offsets.get(n).copied().unwrap_or_default(),
+                t.offsets.get(n + 1).copied().unwrap_or_default(),
+            );
+            for (kind, values) in [("NODES", &w.nodes), ("WEIGHTS", &w.weights)] {
+                let _ = writeln!(
+                    s,
+                    "static {kind}_{n}_{}: [{}; {}] = [",
+                    w.suffix,
+                    w.ty,
+                    b - a
+                );
+                for v in values.get(a..b).unwrap_or_default() {
+                    let _ = writeln!(
+                        s,
+                        "    {}::from_bits(0x{:0digits$x}),",
+                        w.ty,
+                        v,
+                        digits = w.digits
+                    );
+                }
+                let _ = writeln!(s, "];");
+            }
+        }
     }
-    let _ = writeln!(s, "];");
-    let _ = writeln!(
-        s,
-        "pub(crate) static WEIGHTS_F32: [f32; {}] = [",
-        t.weights_f32.len()
-    );
-    for v in &t.weights_f32 {
-        let _ = writeln!(s, "    f32::from_bits(0x{:08x}),", v.to_bits());
-    }
-    let _ = writeln!(s, "];");
     s
 }
 

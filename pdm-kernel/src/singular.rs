@@ -166,9 +166,15 @@ where
     SA: Surface<T> + ?Sized,
     SB: Surface<T> + ?Sized,
 {
-    let (exact, _) = contact(a, b, adjacency_tolerance::<T>());
-    if exact == Adjacency::Identical {
-        return (exact, T::ZERO);
+    // A gap at the level of rounding is no gap: grading for it would only cost time.
+    let rounding = T::from_f64(64.0) * T::EPSILON;
+    let (exact, exact_gap) = contact(a, b, adjacency_tolerance::<T>());
+    if exact != Adjacency::Separate {
+        // Touching within the tight tolerance (or the same patch): the near tolerance could
+        // only blur it (a 1° fold brings the far corners within it too). A gap below the
+        // tolerance but above rounding is still graded for.
+        let gap = if exact == Adjacency::Identical || !(exact_gap > rounding) { T::ZERO } else { exact_gap };
+        return (exact, gap);
     }
     let (adjacency, gap) = contact(a, b, T::from_f64(NEAR_CONTACT));
     if adjacency == Adjacency::Identical {
@@ -176,8 +182,6 @@ where
         // transform applies.
         return (Adjacency::Separate, T::ZERO);
     }
-    // A gap at the level of rounding is no gap: grading for it would only cost time.
-    let rounding = T::from_f64(64.0) * T::EPSILON;
     (adjacency, if gap > rounding { gap } else { T::ZERO })
 }
 

@@ -65,6 +65,11 @@ build libm "" || true
 build micromath micromath || true
 build baseline baseline || true
 build defmt defmt || true
+# Comparison builds (flash figures printed for information, not budgeted; run and checked like
+# the others): the scenes through the run-time-order API, and with concrete types instead of
+# trait objects (BUDGETS.md, "Flash").
+build runtime-order runtime-order || true
+build generic generic || true
 
 # ---- runs ----------------------------------------------------------------------------------
 run_plain() { # name
@@ -80,6 +85,8 @@ run_plain() { # name
 run_plain libm
 run_plain micromath
 run_plain baseline
+run_plain runtime-order
+run_plain generic
 
 # Same backend on both machines: the firmware's bits against a host run of the same scenes.
 # Tolerance 4 ulp per case (measured: 0, bit-identical, for both backends).
@@ -152,6 +159,19 @@ if [ -f "$out/firmware-libm.elf" ] && [ -f "$out/firmware-baseline.elf" ] && [ -
     echo "FLASH kernel part (libm, order 5): $flash_libm bytes (limit $FLASH_LIMIT)"
     echo "FLASH kernel part (micromath, order 5): $flash_mm bytes (saves $((flash_libm - flash_mm)) bytes)"
     [ "$flash_libm" -le "$FLASH_LIMIT" ] || over+=("flash $flash_libm > $FLASH_LIMIT bytes")
+    kernel_part() { # variant -> kernel part of its flash, or nothing if it was not built
+        [ -f "$out/firmware-$1.elf" ] && echo $(( $(text_rodata "$out/firmware-$1.elf") - base ))
+    }
+    flash_runtime_order="$(kernel_part runtime-order || true)"
+    flash_generic="$(kernel_part generic || true)"
+    echo "flash kernel part (libm), for comparison, not budgeted:" \
+        "run-time-order API ${flash_runtime_order:-?} bytes, concrete types ${flash_generic:-?} bytes"
+fi
+# The compile-time order links order 5's Gauss table only (2 × 20 B), not the tables of every order.
+if [ -f "$out/firmware-libm.elf" ]; then
+    tables="$("$llvm_bin/llvm-nm" -C "$out/firmware-libm.elf" | sed -n 's/.*gauss::tables::\([A-Z0-9_]*\).*/\1/p' | sort | tr '\n' ' ')"
+    echo "Gauss tables linked (libm build): $tables"
+    [ "$tables" = "NODES_5_F32 WEIGHTS_5_F32 " ] || fail "the firmware links Gauss tables other than order 5's: $tables"
 fi
 for v in libm micromath; do
     s="$(sed -n 's/^STACK_MAX \([0-9]*\)$/\1/p' "$out/run-$v.log" 2>/dev/null || true)"
@@ -162,6 +182,8 @@ done
 {
     echo "flash_kernel_libm=${flash_libm:-}"
     echo "flash_kernel_micromath=${flash_mm:-}"
+    echo "flash_kernel_libm_runtime_order=${flash_runtime_order:-}"
+    echo "flash_kernel_libm_generic=${flash_generic:-}"
     echo "stack_libm=$(sed -n 's/^STACK_MAX \([0-9]*\)$/\1/p' "$out/run-libm.log" 2>/dev/null || true)"
     echo "stack_micromath=$(sed -n 's/^STACK_MAX \([0-9]*\)$/\1/p' "$out/run-micromath.log" 2>/dev/null || true)"
 } >"$out/budgets.txt"

@@ -12,7 +12,9 @@
 //!
 //! Features: `micromath` (kernel f32 functions from micromath), `defmt` (log with defmt over
 //! semihosting, to be decoded by `defmt-print -e ELF`), `baseline` (kernel calls replaced by an
-//! opaque stand-in, for the flash measurement). See run.sh and BUDGETS.md.
+//! opaque stand-in, for the flash measurement), `runtime-order` and `generic` (the scenes through
+//! the kernel's run-time-order API, or with concrete types instead of trait objects: flash
+//! comparisons). See run.sh and BUDGETS.md.
 
 #![no_std]
 #![no_main]
@@ -51,11 +53,12 @@ const TOL_ULP_LIBM: [u32; scenes::COUNT] = [4, 4, 4];
 /// accuracy cost of the backend, measured (BUDGETS.md). The two parallelogram scenes use no
 /// elementary function whose micromath value differs (their sample points are affine and the
 /// unit normals of unit squares are exact even with micromath's sqrt): measured 0, tolerance
-/// 1e-6. The sphere scene: measured −13.5 % (micromath's sqrt is a bit trick with ~5 % error,
-/// and sample points that its sin/cos put ~1e-3 inside the sphere are occluded by the sphere
-/// itself); tolerance 15 %. That the micromath firmware computes exactly what the host computes
-/// with micromath is checked separately by run.sh (bit patterns, ≤ 4 ulp).
-const TOL_REL_MICROMATH: [f32; scenes::COUNT] = [0.15, 1e-6, 1e-6];
+/// 1e-6. The sphere scene: measured −7.0e-4 (micromath's sin/cos are good to ~1e-3; the kernel
+/// refines its sqrt by Newton steps and widens the on-surface band of the occlusion test to the
+/// backend's error), tolerance 2e-3, the kernel's stated `ELEMENTARY_ERROR` for micromath. That
+/// the micromath firmware computes exactly what the host computes with micromath is checked
+/// separately by run.sh (bit patterns, ≤ 4 ulp).
+const TOL_REL_MICROMATH: [f32; scenes::COUNT] = [2e-3, 1e-6, 1e-6];
 
 /// Whether `value` is within the stated tolerance of scene `i`'s host value.
 fn within_tolerance(i: usize, value: f32, expected: f32) -> bool {

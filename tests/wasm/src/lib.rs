@@ -34,14 +34,14 @@ extern crate std;
 
 use core::sync::atomic::{AtomicU32, AtomicU64, Ordering};
 
-use pdm_kernel::{
-    surface_form_factor, vec3, Parallelogram, PatchGrid, PdmError, Quadrature, Real, Sphere,
-};
+use pdm_kernel::fixed::surface_form_factor_with_rules;
+use pdm_kernel::{vec3, GaussRule, Parallelogram, PatchGrid, PdmError, Real, Sphere, Surface};
 
 /// Sample-buffer capacity per patch: order² ≤ CAP.
 const CAP: usize = 256;
-/// The largest supported Gauss order (order² ≤ CAP).
-const MAX_ORDER: i32 = 16;
+/// The largest supported Gauss order (order² ≤ CAP). The rules are built with
+/// `GaussRule::new_up_to::<16>`, so the module holds the tables of orders 1…16 only.
+const MAX_ORDER: usize = 16;
 /// Pairs that can exist at once.
 const SLOTS: usize = 8;
 /// Parameters of a pair: sphere centre (3), radius, parallelogram origin (3), edge_t (3), edge_s (3).
@@ -182,16 +182,17 @@ fn form_factor<T: Precision>(
 ) -> Result<T, i32> {
     let p = load::<T>(handle)?;
     let (sphere, plane) = build(&p).map_err(kernel_code)?;
-    if !(1..=MAX_ORDER).contains(&order) {
-        return Err(code::UNSUPPORTED_ORDER);
-    }
     let order = usize::try_from(order).map_err(|_| code::UNSUPPORTED_ORDER)?;
-    let sg =
-        PatchGrid::new(&sphere, grid_size(sphere_m)?, grid_size(sphere_n)?).map_err(kernel_code)?;
+    let rule = GaussRule::<T>::new_up_to::<MAX_ORDER>(order).map_err(kernel_code)?;
+    // Both grids over `dyn Surface`: one copy of the sampling code per width instead of one per
+    // surface type (smaller module; the values are the same).
+    let (sphere_dyn, plane_dyn): (&dyn Surface<T>, &dyn Surface<T>) = (&sphere, &plane);
+    let sg = PatchGrid::new(sphere_dyn, grid_size(sphere_m)?, grid_size(sphere_n)?)
+        .map_err(kernel_code)?;
     let pg =
-        PatchGrid::new(&plane, grid_size(plane_m)?, grid_size(plane_n)?).map_err(kernel_code)?;
-    let q = Quadrature::uniform(order);
-    surface_form_factor::<T, _, _, _, CAP>(sg, pg, q, &sphere).map_err(kernel_code)
+        PatchGrid::new(plane_dyn, grid_size(plane_m)?, grid_size(plane_n)?).map_err(kernel_code)?;
+    surface_form_factor_with_rules::<T, _, _, _, CAP>(sg, pg, &rule, &rule, &sphere)
+        .map_err(kernel_code)
 }
 
 fn value_or_code<T: Precision>(r: Result<T, i32>) -> T {
@@ -282,7 +283,7 @@ pub extern "C" fn pdm_form_factor_f32(
 /// The largest supported Gauss order per axis.
 #[no_mangle]
 pub extern "C" fn pdm_max_order() -> i32 {
-    MAX_ORDER
+    MAX_ORDER as i32
 }
 
 /// How many pairs can exist at once.

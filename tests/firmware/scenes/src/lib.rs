@@ -4,15 +4,88 @@
 
 #![no_std]
 
-use pdm_kernel::{
-    form_factor_between, surface_form_factor, vec3, Parallelogram, Patch, PatchGrid, PdmError,
-    Quadrature, Sphere,
-};
+use pdm_kernel::{vec3, Occluder, Parallelogram, Patch, PatchGrid, PdmError, Sphere, Surface};
 
 /// Gauss order per axis on each patch (the paper's 5).
 pub const ORDER: usize = 5;
 /// Sample-buffer capacity: ORDER².
 pub const CAP: usize = ORDER * ORDER;
+
+// How the scenes reach the kernel (BUDGETS.md, "Flash"). By default every surface and occluder
+// is passed as a trait object, so the kernel's sampling and summation code is instantiated once
+// (for `dyn Surface<f32>` / `dyn Occluder<f32>`) and shared by the three scenes, as firmware that
+// watches its flash would do; the `generic` feature passes the concrete types instead (one copy
+// of the kernel code per combination of surface and occluder types). Same values either way.
+#[cfg(not(feature = "generic"))]
+macro_rules! surface {
+    ($s:expr) => {
+        $s as &dyn Surface<f32>
+    };
+}
+#[cfg(feature = "generic")]
+macro_rules! surface {
+    ($s:expr) => {
+        $s
+    };
+}
+#[cfg(not(feature = "generic"))]
+macro_rules! occluder {
+    ($o:expr) => {
+        $o as &dyn Occluder<f32>
+    };
+}
+#[cfg(feature = "generic")]
+macro_rules! occluder {
+    ($o:expr) => {
+        $o
+    };
+}
+
+/// Surface form factor at order [`ORDER`] through the compile-time-order entry point (links
+/// order 5's Gauss table only), or with the `runtime-order` feature through the `Quadrature` one.
+/// Both give the same bits.
+fn surface_ff<SA, SB, O>(
+    a: PatchGrid<'_, f32, SA>,
+    b: PatchGrid<'_, f32, SB>,
+    occluders: &O,
+) -> Result<f32, PdmError>
+where
+    SA: Surface<f32> + ?Sized,
+    SB: Surface<f32> + ?Sized,
+    O: Occluder<f32> + ?Sized,
+{
+    #[cfg(not(feature = "runtime-order"))]
+    {
+        pdm_kernel::fixed::surface_form_factor_fixed::<f32, _, _, _, ORDER, CAP>(a, b, occluders)
+    }
+    #[cfg(feature = "runtime-order")]
+    {
+        let q = pdm_kernel::Quadrature::uniform(ORDER);
+        pdm_kernel::surface_form_factor::<f32, _, _, _, CAP>(a, b, q, occluders)
+    }
+}
+
+/// Patch-to-patch form factor at order [`ORDER`] (see [`surface_ff`]).
+fn patch_ff<SA, SB, O>(
+    a: &Patch<'_, f32, SA>,
+    b: &Patch<'_, f32, SB>,
+    occluders: &O,
+) -> Result<f32, PdmError>
+where
+    SA: Surface<f32> + ?Sized,
+    SB: Surface<f32> + ?Sized,
+    O: Occluder<f32> + ?Sized,
+{
+    #[cfg(not(feature = "runtime-order"))]
+    {
+        pdm_kernel::fixed::form_factor_between_fixed::<f32, _, _, _, ORDER, CAP>(a, b, occluders)
+    }
+    #[cfg(feature = "runtime-order")]
+    {
+        let q = pdm_kernel::Quadrature::uniform(ORDER);
+        pdm_kernel::form_factor_between::<f32, _, _, _, CAP>(a, b, q, occluders)
+    }
+}
 
 /// Number of scenes.
 pub const COUNT: usize = 3;
@@ -29,11 +102,10 @@ pub fn sphere_to_face() -> Result<f32, PdmError> {
         vec3(6.0, 0.0, 0.0),
         vec3(0.0, 6.0, 0.0),
     )?;
-    surface_form_factor::<f32, _, _, _, CAP>(
-        PatchGrid::new(&sphere, 4, 8)?,
-        PatchGrid::new(&floor, 3, 3)?,
-        Quadrature::uniform(ORDER),
-        &sphere,
+    surface_ff(
+        PatchGrid::new(surface!(&sphere), 4, 8)?,
+        PatchGrid::new(surface!(&floor), 3, 3)?,
+        occluder!(&sphere),
     )
 }
 
@@ -52,11 +124,10 @@ pub fn shared_edge() -> Result<f32, PdmError> {
         vec3(0.0, 0.0, 1.0),
         vec3(1.0, 0.0, 0.0),
     )?;
-    form_factor_between::<f32, _, _, _, CAP>(
-        &Patch::whole(&floor)?,
-        &Patch::whole(&wall)?,
-        Quadrature::uniform(ORDER),
-        &(),
+    patch_ff(
+        &Patch::whole(surface!(&floor))?,
+        &Patch::whole(surface!(&wall))?,
+        occluder!(&()),
     )
 }
 
@@ -79,11 +150,10 @@ pub fn occluded_pair() -> Result<f32, PdmError> {
         vec3(0.5, 0.0, 0.0),
         vec3(0.0, 0.5, 0.0),
     )?;
-    form_factor_between::<f32, _, _, _, CAP>(
-        &Patch::whole(&lower)?,
-        &Patch::whole(&upper)?,
-        Quadrature::uniform(ORDER),
-        &blocker,
+    patch_ff(
+        &Patch::whole(surface!(&lower))?,
+        &Patch::whole(surface!(&upper))?,
+        occluder!(&blocker),
     )
 }
 
