@@ -1,5 +1,8 @@
 //! Closed-form references against the REFERENCES.md 16-digit values (Howell's catalogue).
 
+// Test code: panicking on failure and indexing fixed-size test data is intended.
+#![allow(clippy::panic, clippy::indexing_slicing, clippy::excessive_precision, clippy::unreadable_literal)]
+
 use pdm_host::reference::closed_form::*;
 use std::f64::consts::PI;
 
