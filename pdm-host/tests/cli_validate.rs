@@ -1,28 +1,18 @@
 //! `pdm validate` end to end: the JSON contract, bad input, and real checks of the kernel
 //! (the empty cube against C-11/C-14, the paper's grid against 1/6).
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    clippy::panic,
-    clippy::indexing_slicing
-)]
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
 
 use std::process::{Command, Output};
 
 use serde_json::Value;
 
-const PAIRS: [&str; 15] = [
-    "1-2", "1-3", "1-4", "1-5", "1-6", "2-3", "2-4", "2-5", "2-6", "3-4", "3-5", "3-6", "4-5",
-    "4-6", "5-6",
-];
+const PAIRS: [&str; 15] =
+    ["1-2", "1-3", "1-4", "1-5", "1-6", "2-3", "2-4", "2-5", "2-6", "3-4", "3-5", "3-6", "4-5", "4-6", "5-6"];
 const C11: f64 = 0.1998248956983874; // Howell C-11, unit squares at distance 1
 const C14: f64 = 0.2000437760754032; // Howell C-14, unit squares with a common edge
 
 fn pdm(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_pdm"))
-        .args(args)
-        .output()
-        .expect("run pdm")
+    Command::new(env!("CARGO_BIN_EXE_pdm")).args(args).output().expect("run pdm")
 }
 
 fn validate_json(args: &[&str]) -> Value {
@@ -32,31 +22,19 @@ fn validate_json(args: &[&str]) -> Value {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "pdm {all:?} failed: {stderr}");
     // Nothing but the JSON object on stdout.
-    serde_json::from_slice(&out.stdout)
-        .unwrap_or_else(|e| panic!("stdout is not one JSON value: {e}"))
+    serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("stdout is not one JSON value: {e}"))
 }
 
 fn numbers(v: &Value, n: usize) -> Vec<f64> {
     let a = v.as_array().unwrap_or_else(|| panic!("not an array: {v}"));
     assert_eq!(a.len(), n, "{v}");
-    a.iter()
-        .map(|x| x.as_f64().unwrap_or_else(|| panic!("not a number: {x}")))
-        .collect()
+    a.iter().map(|x| x.as_f64().unwrap_or_else(|| panic!("not a number: {x}"))).collect()
 }
 
 fn pair_numbers(v: &Value) -> Vec<f64> {
-    let o = v
-        .as_object()
-        .unwrap_or_else(|| panic!("not an object: {v}"));
+    let o = v.as_object().unwrap_or_else(|| panic!("not an object: {v}"));
     assert_eq!(o.len(), 15, "{v}");
-    PAIRS
-        .iter()
-        .map(|k| {
-            o.get(*k)
-                .and_then(Value::as_f64)
-                .unwrap_or_else(|| panic!("no number at {k}: {v}"))
-        })
-        .collect()
+    PAIRS.iter().map(|k| o.get(*k).and_then(Value::as_f64).unwrap_or_else(|| panic!("no number at {k}: {v}"))).collect()
 }
 
 fn is_opposite(pair: &str) -> bool {
@@ -65,16 +43,7 @@ fn is_opposite(pair: &str) -> bool {
 
 #[test]
 fn json_contract_small_grid() {
-    let j = validate_json(&[
-        "--sphere-grid",
-        "2x4",
-        "--face-grid",
-        "2",
-        "--order",
-        "3",
-        "--repeat",
-        "1",
-    ]);
+    let j = validate_json(&["--sphere-grid", "2x4", "--face-grid", "2", "--order", "3", "--repeat", "1"]);
     let s2f = numbers(&j["sphere_to_face"], 6);
     assert!(s2f.iter().all(|f| (f - 1.0 / 6.0).abs() < 0.05), "{s2f:?}");
     let ff = pair_numbers(&j["face_to_face"]);
@@ -122,16 +91,7 @@ fn json_paper_grid_86_sphere_to_face_within_one_percent() {
 /// closed forms to 1e-9, and each face's factors must sum to 1.
 #[test]
 fn empty_cube_accurate_matches_c11_c14() {
-    let j = validate_json(&[
-        "--sphere-radius",
-        "0",
-        "--mode",
-        "accurate",
-        "--face-grid",
-        "2",
-        "--order",
-        "10",
-    ]);
+    let j = validate_json(&["--sphere-radius", "0", "--mode", "accurate", "--face-grid", "2", "--order", "10"]);
     assert!(j["sphere_to_face"].is_null());
     assert!(j["reference"]["sphere_to_face"].is_null());
     let ff = pair_numbers(&j["face_to_face"]);
@@ -139,10 +99,7 @@ fn empty_cube_accurate_matches_c11_c14() {
     for ((pair, ours), re) in PAIRS.iter().zip(&ff).zip(&reference) {
         let exact = if is_opposite(pair) { C11 } else { C14 };
         assert!((re - exact).abs() < 1e-15, "{pair}: reference {re}");
-        assert!(
-            (ours - exact).abs() < 1e-9 * exact,
-            "{pair}: {ours} vs {exact}"
-        );
+        assert!((ours - exact).abs() < 1e-9 * exact, "{pair}: {ours} vs {exact}");
     }
     for (f, s) in numbers(&j["face_sum"], 6).iter().enumerate() {
         assert!((s - 1.0).abs() < 1e-9, "face {} sums to {s}", f + 1);
@@ -153,16 +110,7 @@ fn empty_cube_accurate_matches_c11_c14() {
 
 #[test]
 fn both_precisions_nest_f32() {
-    let j = validate_json(&[
-        "--sphere-radius",
-        "0",
-        "--face-grid",
-        "2",
-        "--precision",
-        "both",
-        "--repeat",
-        "1",
-    ]);
+    let j = validate_json(&["--sphere-radius", "0", "--face-grid", "2", "--precision", "both", "--repeat", "1"]);
     assert_eq!(j["precision"], "f64");
     assert_eq!(j["f32"]["precision"], "f32");
     let a = pair_numbers(&j["face_to_face"]);
@@ -176,61 +124,23 @@ fn both_precisions_nest_f32() {
 fn table_fits_80_columns_and_csv_has_rows() {
     for args in [
         &["validate", "--patches", "86", "--repeat", "1"][..],
-        &[
-            "validate",
-            "--sphere-radius",
-            "0",
-            "--face-grid",
-            "2",
-            "--precision",
-            "both",
-            "--repeat",
-            "1",
-        ][..],
+        &["validate", "--sphere-radius", "0", "--face-grid", "2", "--precision", "both", "--repeat", "1"][..],
     ] {
         let out = pdm(args);
         assert!(out.status.success());
         let text = String::from_utf8(out.stdout).unwrap();
         for line in text.lines() {
-            assert!(
-                line.chars().count() <= 80,
-                "{} columns: {line}",
-                line.chars().count()
-            );
+            assert!(line.chars().count() <= 80, "{} columns: {line}", line.chars().count());
         }
-        assert!(
-            text.contains("Table 3") && text.contains("Table 4"),
-            "{text}"
-        );
+        assert!(text.contains("Table 3") && text.contains("Table 4"), "{text}");
     }
-    let out = pdm(&[
-        "validate",
-        "--format",
-        "csv",
-        "--sphere-radius",
-        "0",
-        "--face-grid",
-        "2",
-        "--repeat",
-        "1",
-    ]);
+    let out = pdm(&["validate", "--format", "csv", "--sphere-radius", "0", "--face-grid", "2", "--repeat", "1"]);
     assert!(out.status.success());
     let text = String::from_utf8(out.stdout).unwrap();
     let mut lines = text.lines();
-    assert_eq!(
-        lines.next(),
-        Some("table,item,precision,paper,ours,reference,relative_error,reference_uncertainty")
-    );
-    assert_eq!(
-        text.lines()
-            .filter(|l| l.starts_with("face_to_face,"))
-            .count(),
-        15
-    );
-    assert_eq!(
-        text.lines().filter(|l| l.starts_with("face_sum,")).count(),
-        6
-    );
+    assert_eq!(lines.next(), Some("table,item,precision,paper,ours,reference,relative_error,reference_uncertainty"));
+    assert_eq!(text.lines().filter(|l| l.starts_with("face_to_face,")).count(), 15);
+    assert_eq!(text.lines().filter(|l| l.starts_with("face_sum,")).count(), 6);
     assert!(text.lines().all(|l| l.split(',').count() == 8), "{text}");
 }
 
@@ -270,10 +180,7 @@ fn bad_input_is_one_line_naming_the_value() {
         let lines: Vec<&str> = stderr.lines().filter(|l| !l.trim().is_empty()).collect();
         assert_eq!(lines.len(), 1, "{all:?}: not one line: {stderr}");
         assert!(lines[0].starts_with("error:"), "{all:?}: {stderr}");
-        assert!(
-            lines[0].contains(named),
-            "{all:?}: does not name {named}: {stderr}"
-        );
+        assert!(lines[0].contains(named), "{all:?}: does not name {named}: {stderr}");
         assert!(out.stdout.is_empty(), "{all:?}: wrote to stdout");
     }
 }
@@ -283,10 +190,7 @@ fn help_and_no_subcommand() {
     let out = pdm(&["validate", "--help"]);
     assert!(out.status.success());
     let text = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        text.contains("--sphere-radius") && text.contains("--patches"),
-        "{text}"
-    );
+    assert!(text.contains("--sphere-radius") && text.contains("--patches"), "{text}");
     let out = pdm(&[]);
     assert!(!out.status.success());
 }

@@ -2,18 +2,13 @@
 //! `pdm_host::gauss_gen`: the committed file must be byte-identical to the generator's output, the
 //! multi-precision reference must itself be right, and every f64/f32 entry must be the correctly
 //! rounded reference value.
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    clippy::panic,
-    clippy::indexing_slicing
-)]
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
 
 use dashu_int::ops::UnsignedAbs;
 use dashu_int::{IBig, UBig};
 use pdm_host::gauss_gen::{
-    self, fixed_from_f32, fixed_from_f64, hp_rule, hp_rule_with_bits, round_to_f32, round_to_f64,
-    ERROR_BOUND_BITS, FRAC_BITS, MAX_ORDER, TABLE_LEN,
+    self, fixed_from_f32, fixed_from_f64, hp_rule, hp_rule_with_bits, round_to_f32, round_to_f64, ERROR_BOUND_BITS,
+    FRAC_BITS, MAX_ORDER, TABLE_LEN,
 };
 
 /// |x| < 10^−digits, for x = raw · 2^−bits.
@@ -23,11 +18,8 @@ fn below_ten_to_minus(raw: &IBig, bits: usize, digits: u32) -> bool {
 
 #[test]
 fn gauss_tables_are_bit_exact() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("..")
-        .join("pdm-kernel/src/gauss/tables.rs");
-    let committed = std::fs::read_to_string(&path)
-        .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("pdm-kernel/src/gauss/tables.rs");
+    let committed = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
     let generated = gauss_gen::render_tables().expect("table generation failed");
     if let Some((line, old, new)) = gauss_gen::first_difference(&committed, &generated) {
         panic!(
@@ -52,32 +44,16 @@ fn reference_rules_integrate_exactly() {
         for pair in rule.nodes.windows(2) {
             assert!(pair[0] < pair[1], "order {n}: nodes not strictly ascending");
         }
-        assert!(rule
-            .nodes
-            .iter()
-            .all(|x| x.clone().unsigned_abs() < one.clone().unsigned_abs()));
+        assert!(rule.nodes.iter().all(|x| x.clone().unsigned_abs() < one.clone().unsigned_abs()));
         assert!(rule.weights.iter().all(|w| *w > IBig::ZERO));
 
         let mut powers: Vec<IBig> = vec![one.clone(); n]; // x_i^(2k)
         for k in 0..n {
-            let sum: IBig = rule
-                .weights
-                .iter()
-                .zip(&powers)
-                .map(|(w, p)| (w * p) >> bits)
-                .sum();
+            let sum: IBig = rule.weights.iter().zip(&powers).map(|(w, p)| (w * p) >> bits).sum();
             let exact = (IBig::from(2_u8) << bits) / IBig::from(2 * k + 1);
             let diff = &sum - &exact;
-            assert!(
-                below_ten_to_minus(&diff, bits, 40),
-                "order {n}: moment x^{} off by more than 1e-40",
-                2 * k
-            );
-            assert!(
-                below_ten_to_minus(&diff, bits, 70),
-                "order {n}: moment x^{} off by > 1e-70",
-                2 * k
-            );
+            assert!(below_ten_to_minus(&diff, bits, 40), "order {n}: moment x^{} off by more than 1e-40", 2 * k);
+            assert!(below_ten_to_minus(&diff, bits, 70), "order {n}: moment x^{} off by > 1e-70", 2 * k);
             for (p, x) in powers.iter_mut().zip(&rule.nodes) {
                 *p = (&*p * x * x) >> (2 * bits);
             }
@@ -94,17 +70,10 @@ fn reference_error_bound_holds() {
     for n in 1..=MAX_ORDER {
         let lo = hp_rule(n).unwrap();
         let hi = hp_rule_with_bits(n, FRAC_BITS + 128).unwrap();
-        let pairs = lo
-            .nodes
-            .iter()
-            .zip(&hi.nodes)
-            .chain(lo.weights.iter().zip(&hi.weights));
+        let pairs = lo.nodes.iter().zip(&hi.nodes).chain(lo.weights.iter().zip(&hi.weights));
         for (a, b) in pairs {
             let err = (a - (b >> 128)).unsigned_abs();
-            assert!(
-                err < bound,
-                "order {n}: reference error above 2^{ERROR_BOUND_BITS} units"
-            );
+            assert!(err < bound, "order {n}: reference error above 2^{ERROR_BOUND_BITS} units");
             if err > worst {
                 worst = err;
             }
@@ -118,76 +87,36 @@ fn tables_are_exactly_symmetric() {
     let t = gauss_gen::tables().unwrap();
     assert_eq!(t.offsets.len(), MAX_ORDER + 2);
     assert_eq!((t.offsets[0], t.offsets[1]), (0, 0));
-    for v in [
-        t.nodes_f64.len(),
-        t.weights_f64.len(),
-        t.nodes_f32.len(),
-        t.weights_f32.len(),
-    ] {
+    for v in [t.nodes_f64.len(), t.weights_f64.len(), t.nodes_f32.len(), t.weights_f32.len()] {
         assert_eq!(v, TABLE_LEN);
     }
     for n in 1..=MAX_ORDER {
         let (a, b) = (t.offsets[n], t.offsets[n + 1]);
         assert_eq!(b - a, n);
-        let (x64, w64, x32, w32) = (
-            &t.nodes_f64[a..b],
-            &t.weights_f64[a..b],
-            &t.nodes_f32[a..b],
-            &t.weights_f32[a..b],
-        );
+        let (x64, w64, x32, w32) = (&t.nodes_f64[a..b], &t.weights_f64[a..b], &t.nodes_f32[a..b], &t.weights_f32[a..b]);
         for k in 0..n {
             let m = n - 1 - k;
             if k != m {
-                assert_eq!(
-                    x64[k].to_bits(),
-                    (-x64[m]).to_bits(),
-                    "order {n} node {k} (f64)"
-                );
-                assert_eq!(
-                    x32[k].to_bits(),
-                    (-x32[m]).to_bits(),
-                    "order {n} node {k} (f32)"
-                );
+                assert_eq!(x64[k].to_bits(), (-x64[m]).to_bits(), "order {n} node {k} (f64)");
+                assert_eq!(x32[k].to_bits(), (-x32[m]).to_bits(), "order {n} node {k} (f32)");
             }
-            assert_eq!(
-                w64[k].to_bits(),
-                w64[m].to_bits(),
-                "order {n} weight {k} (f64)"
-            );
-            assert_eq!(
-                w32[k].to_bits(),
-                w32[m].to_bits(),
-                "order {n} weight {k} (f32)"
-            );
+            assert_eq!(w64[k].to_bits(), w64[m].to_bits(), "order {n} weight {k} (f64)");
+            assert_eq!(w32[k].to_bits(), w32[m].to_bits(), "order {n} weight {k} (f32)");
         }
         if n % 2 == 1 {
-            assert_eq!(
-                x64[n / 2].to_bits(),
-                0,
-                "order {n}: middle node must be +0.0"
-            );
-            assert_eq!(
-                x32[n / 2].to_bits(),
-                0,
-                "order {n}: middle node must be +0.0"
-            );
+            assert_eq!(x64[n / 2].to_bits(), 0, "order {n}: middle node must be +0.0");
+            assert_eq!(x32[n / 2].to_bits(), 0, "order {n}: middle node must be +0.0");
         }
     }
 }
 
 /// The two representable neighbours of a nonzero finite f64 (below, above in magnitude).
 fn neighbours_f64(v: f64) -> (f64, f64) {
-    (
-        f64::from_bits(v.to_bits() - 1),
-        f64::from_bits(v.to_bits() + 1),
-    )
+    (f64::from_bits(v.to_bits() - 1), f64::from_bits(v.to_bits() + 1))
 }
 
 fn neighbours_f32(v: f32) -> (f32, f32) {
-    (
-        f32::from_bits(v.to_bits() - 1),
-        f32::from_bits(v.to_bits() + 1),
-    )
+    (f32::from_bits(v.to_bits() - 1), f32::from_bits(v.to_bits() + 1))
 }
 
 /// Half an ulp of the normal float `v` with `mant` stored significand bits, in units of 2^−bits.
@@ -208,16 +137,8 @@ fn entries_are_correctly_rounded() {
         let rule = hp_rule(n).unwrap();
         let bits = rule.frac_bits;
         let a = t.offsets[n];
-        let values = rule
-            .nodes
-            .iter()
-            .enumerate()
-            .map(|(i, x)| (x, t.nodes_f64[a + i], t.nodes_f32[a + i]));
-        let weights = rule
-            .weights
-            .iter()
-            .enumerate()
-            .map(|(i, w)| (w, t.weights_f64[a + i], t.weights_f32[a + i]));
+        let values = rule.nodes.iter().enumerate().map(|(i, x)| (x, t.nodes_f64[a + i], t.nodes_f32[a + i]));
+        let weights = rule.weights.iter().enumerate().map(|(i, w)| (w, t.weights_f64[a + i], t.weights_f32[a + i]));
         for (hp, v64, v32) in values.chain(weights) {
             checked += 1;
             if *hp == IBig::ZERO {
@@ -228,20 +149,14 @@ fn entries_are_correctly_rounded() {
 
             let d64 = dist(fixed_from_f64(v64, bits).unwrap());
             let h64 = half_ulp_units((v64.to_bits() >> 52) & 0x7ff, 1023, 52, bits);
-            assert!(
-                d64 <= h64,
-                "order {n}: f64 {v64:e} more than half an ulp from the reference"
-            );
+            assert!(d64 <= h64, "order {n}: f64 {v64:e} more than half an ulp from the reference");
             let (lo, up) = neighbours_f64(v64);
             assert!(d64 < dist(fixed_from_f64(lo, bits).unwrap()));
             assert!(d64 < dist(fixed_from_f64(up, bits).unwrap()));
 
             let d32 = dist(fixed_from_f32(v32, bits).unwrap());
             let h32 = half_ulp_units(u64::from((v32.to_bits() >> 23) & 0xff), 127, 23, bits);
-            assert!(
-                d32 <= h32,
-                "order {n}: f32 {v32:e} more than half an ulp from the reference"
-            );
+            assert!(d32 <= h32, "order {n}: f32 {v32:e} more than half an ulp from the reference");
             let (lo, up) = neighbours_f32(v32);
             assert!(d32 < dist(fixed_from_f32(lo, bits).unwrap()));
             assert!(d32 < dist(fixed_from_f32(up, bits).unwrap()));
@@ -252,19 +167,9 @@ fn entries_are_correctly_rounded() {
                 double_rounding_cases += 1;
                 let (lo, up) = neighbours_f32(v32);
                 let other = if via_f64 == lo { lo } else { up };
-                assert_eq!(
-                    via_f64.to_bits(),
-                    other.to_bits(),
-                    "order {n}: f64→f32 off by > 1 ulp"
-                );
-                let mid = (fixed_from_f32(v32, bits).unwrap()
-                    + fixed_from_f32(other, bits).unwrap())
-                    >> 1;
-                assert_eq!(
-                    fixed_from_f64(v64, bits).unwrap(),
-                    mid,
-                    "order {n}: not a double-rounding case"
-                );
+                assert_eq!(via_f64.to_bits(), other.to_bits(), "order {n}: f64→f32 off by > 1 ulp");
+                let mid = (fixed_from_f32(v32, bits).unwrap() + fixed_from_f32(other, bits).unwrap()) >> 1;
+                assert_eq!(fixed_from_f64(v64, bits).unwrap(), mid, "order {n}: not a double-rounding case");
             }
         }
     }
@@ -295,10 +200,7 @@ fn rounding_primitives() {
     // Values within the error bound of 1 (just below and above) still round to 1 exactly.
     let near = UBig::ONE << 20;
     let one = IBig::ONE << bits;
-    assert_eq!(
-        round_to_f64(&(&one - IBig::from(near.clone())), bits),
-        Some(1.0)
-    );
+    assert_eq!(round_to_f64(&(&one - IBig::from(near.clone())), bits), Some(1.0));
     assert_eq!(round_to_f32(&(&one + IBig::from(near)), bits), Some(1.0));
 
     // Exactly on (or within the error bound of) a midpoint: refused rather than guessed.

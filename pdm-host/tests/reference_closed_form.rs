@@ -90,7 +90,7 @@ fn sphere_identities() {
     assert!(rel(differential_area_to_sphere(1.0, 3.0, 0.0), 1.0 / 9.0) < 1e-15);
     assert!(rel(differential_area_to_sphere(1.0, 2.0, 0.5), 0.5f64.cos() / 4.0) < 1e-15);
     assert!(differential_area_to_sphere(1.0, 2.0, 1.2).is_nan()); // sphere cut by the horizon
-    // inside of a sphere: F = A_j / (4πR²); a hemisphere sees half.
+                                                                  // inside of a sphere: F = A_j / (4πR²); a hemisphere sees half.
     let r = 2.0;
     let hemi = sphere_zone_area(r, 0.0, r);
     assert!(rel(sphere_interior_factor(r, hemi), 0.5) < 1e-15);

@@ -116,7 +116,13 @@ fn dihedral_sweep_shared_edge() {
         // absolute agreement at the rounding level of the contour sum (its terms are O(1)),
         // and relative 1e-13 wherever F is not tiny (179°: F = 2.4e-5, 1e-12 relative).
         assert!((f - mp).abs() < 5e-16 && (f_split - mp).abs() < 5e-16, "{a}: {f} {f_split} {mp}");
-        let rel_tol = if mp > 1e-3 { 1e-13 } else if mp > 1e-6 { 1e-11 } else { 1e-6 };
+        let rel_tol = if mp > 1e-3 {
+            1e-13
+        } else if mp > 1e-6 {
+            1e-11
+        } else {
+            1e-6
+        };
         assert!(rel(f, mp) < rel_tol && rel(f_split, mp) < rel_tol, "{a}: {f} vs {mp}");
         if a == 90.0 {
             assert!(rel(f, 0.2000437760754032) < 1e-13);

@@ -53,7 +53,9 @@ fn paper_scene_l6_r1_sum_rule_and_reference_values() {
 #[test]
 fn extra_radii_close_the_sum_rule() {
     // (R, F_adj, F_opp) for l = 6, converged values (release run of `radius_sweep`)
-    for &(radius, adj, opp) in &[(0.5, 0.1996465146972331, 0.1868695307777818), (2.0, 0.1752262403088012, 0.0663844718322179)] {
+    for &(radius, adj, opp) in
+        &[(0.5, 0.1996465146972331, 0.1868695307777818), (2.0, 0.1752262403088012, 0.0663844718322179)]
+    {
         let r = cube_face_factors_with_order(6.0, radius, 8);
         eprintln!("l=6 R={radius}: {r:?}");
         assert!(r.sum_rule_residual.abs() < 1e-10, "{}", r.sum_rule_residual);
@@ -120,7 +122,12 @@ fn monte_carlo_agrees_with_deterministic_reference_large() {
         ("opposite", mc.f_opposite, F_OPP_L6_R1),
         ("sphere", mc.f_face_to_sphere, cube_face_to_centred_sphere(6.0, 1.0)),
     ] {
-        eprintln!("{name}: MC {:.7} ± {:.1e}  deterministic {exact:.16}  ({:+.2} σ)", est.value, est.std_error, (est.value - exact) / est.std_error);
+        eprintln!(
+            "{name}: MC {:.7} ± {:.1e}  deterministic {exact:.16}  ({:+.2} σ)",
+            est.value,
+            est.std_error,
+            (est.value - exact) / est.std_error
+        );
         assert!((est.value - exact).abs() < 4.0 * est.std_error, "{est:?} vs {exact}");
     }
 }
@@ -133,7 +140,13 @@ fn radius_sweep() {
         let x = cube_face_factors(6.0, r);
         eprintln!(
             "l=6 R={r}: F_adj {:.16} ± {:.1e}  F_opp {:.16} ± {:.1e}  F_face→sphere {:.16}  sum−1 {:.1e}  ({:?})",
-            x.f_adjacent, x.f_adjacent_error, x.f_opposite, x.f_opposite_error, x.f_face_to_sphere, x.sum_rule_residual, t.elapsed()
+            x.f_adjacent,
+            x.f_adjacent_error,
+            x.f_opposite,
+            x.f_opposite_error,
+            x.f_face_to_sphere,
+            x.sum_rule_residual,
+            t.elapsed()
         );
         assert!(x.sum_rule_residual.abs() < 1e-12);
         assert!(x.f_adjacent_error < 1e-12 && x.f_opposite_error < 1e-12);

@@ -100,7 +100,11 @@ where
         Adjacency::SharedEdge { .. } | Adjacency::SharedVertex { .. } => {
             let per_order = |p: usize| -> u64 {
                 let p4 = (p as u64).pow(4);
-                if matches!(adjacency, Adjacency::SharedEdge { .. }) { 12 * p4 } else { 4 * p4 }
+                if matches!(adjacency, Adjacency::SharedEdge { .. }) {
+                    12 * p4
+                } else {
+                    4 * p4
+                }
             };
             let mut p = 6;
             let mut evaluations = per_order(p);
@@ -262,7 +266,10 @@ fn half_patch<'s, T: Real, S: Surface<T> + ?Sized>(p: &Patch<'s, T, S>, k: usize
 }
 
 /// `true` if some sample pairs pass the two-sided curvature test and others do not.
-pub(crate) fn straddles_curvature_cut<T: Real, const CA: usize, const CB: usize>(a: &PatchSamples<T, CA>, b: &PatchSamples<T, CB>) -> bool {
+pub(crate) fn straddles_curvature_cut<T: Real, const CA: usize, const CB: usize>(
+    a: &PatchSamples<T, CA>,
+    b: &PatchSamples<T, CB>,
+) -> bool {
     let mut seen_visible = false;
     let mut seen_hidden = false;
     for sa in a.iter() {

@@ -40,11 +40,9 @@ pub enum PdmError {
 impl fmt::Display for PdmError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            Self::UnsupportedOrder { order } => write!(
-                f,
-                "unsupported Gauss-Legendre order {order} (supported: 1..={})",
-                crate::gauss::MAX_ORDER
-            ),
+            Self::UnsupportedOrder { order } => {
+                write!(f, "unsupported Gauss-Legendre order {order} (supported: 1..={})", crate::gauss::MAX_ORDER)
+            }
             Self::NonFinite => f.write_str("non-finite (NaN or infinite) input or intermediate value"),
             Self::EmptyParameterRange => f.write_str("empty parameter range (start >= end)"),
             Self::Degenerate => f.write_str("degenerate geometry (zero area or invalid shape parameter)"),

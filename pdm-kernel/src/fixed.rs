@@ -163,40 +163,23 @@ mod tests {
         let sphere = Sphere::outer(vec3(T::ZERO, T::ZERO, T::ZERO), T::ONE).unwrap();
         let three = T::from_f64(3.0);
         let six = T::from_f64(6.0);
-        let floor = Parallelogram::new(
-            vec3(-three, -three, -three),
-            vec3(six, T::ZERO, T::ZERO),
-            vec3(T::ZERO, six, T::ZERO),
-        )
-        .unwrap();
+        let floor =
+            Parallelogram::new(vec3(-three, -three, -three), vec3(six, T::ZERO, T::ZERO), vec3(T::ZERO, six, T::ZERO))
+                .unwrap();
         let sg = PatchGrid::new(&sphere, 2, 4).unwrap();
         let fg = PatchGrid::new(&floor, 2, 2).unwrap();
-        let q = surface_form_factor::<T, _, _, _, 49>(
-            sg.clone(),
-            fg.clone(),
-            Quadrature::uniform(5),
-            &sphere,
-        )
-        .unwrap();
-        let f = surface_form_factor_fixed::<T, _, _, _, 5, 49>(sg.clone(), fg.clone(), &sphere)
-            .unwrap();
+        let q = surface_form_factor::<T, _, _, _, 49>(sg.clone(), fg.clone(), Quadrature::uniform(5), &sphere).unwrap();
+        let f = surface_form_factor_fixed::<T, _, _, _, 5, 49>(sg.clone(), fg.clone(), &sphere).unwrap();
         assert_eq!(f, q);
         let q = surface_form_factor::<T, _, _, _, 49>(
             sg.clone(),
             fg.clone(),
-            Quadrature {
-                order_a: 4,
-                order_b: 7,
-            },
+            Quadrature { order_a: 4, order_b: 7 },
             &sphere,
         )
         .unwrap();
-        let (r4, r7) = (
-            GaussRule::<T>::fixed::<4>(),
-            GaussRule::<T>::new_up_to::<7>(7).unwrap(),
-        );
-        let f =
-            surface_form_factor_with_rules::<T, _, _, _, 49>(sg, fg, &r4, &r7, &sphere).unwrap();
+        let (r4, r7) = (GaussRule::<T>::fixed::<4>(), GaussRule::<T>::new_up_to::<7>(7).unwrap());
+        let f = surface_form_factor_with_rules::<T, _, _, _, 49>(sg, fg, &r4, &r7, &sphere).unwrap();
         assert_eq!(f, q);
 
         let a = Patch::whole(&floor).unwrap();
@@ -219,26 +202,15 @@ mod tests {
 
     #[test]
     fn errors_are_reported() {
-        let p = Parallelogram::new(
-            vec3(0.0_f64, 0.0, 0.0),
-            vec3(1.0, 0.0, 0.0),
-            vec3(0.0, 1.0, 0.0),
-        )
-        .unwrap();
+        let p = Parallelogram::new(vec3(0.0_f64, 0.0, 0.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0)).unwrap();
         let a = Patch::whole(&p).unwrap();
         // A rule too large for the buffers.
         let r = GaussRule::<f64>::fixed::<6>();
         assert!(matches!(
             form_factor_between_with_rules::<f64, _, _, _, 25>(&a, &a, &r, &r, &()),
-            Err(PdmError::CapacityExceeded {
-                needed: 36,
-                capacity: 25
-            })
+            Err(PdmError::CapacityExceeded { needed: 36, capacity: 25 })
         ));
         // Coplanar patches face away from each other: zero, not an error.
-        assert_eq!(
-            form_factor_between_fixed::<f64, _, _, _, 3, 9>(&a, &a, &()).unwrap(),
-            0.0
-        );
+        assert_eq!(form_factor_between_fixed::<f64, _, _, _, 3, 9>(&a, &a, &()).unwrap(), 0.0);
     }
 }

@@ -273,7 +273,12 @@ fn inner_sum_unoccluded<T: Real>(p: [T; 3], n: [T; 3], cols: Columns<'_, T>) -> 
 
 /// Inner sum with occluders: the occlusion test runs only for pairs that pass the curvature test.
 #[inline(always)]
-fn inner_sum_occluded<T: Real, O: Occluder<T> + ?Sized>(p: [T; 3], n: [T; 3], cols: Columns<'_, T>, occluders: &O) -> T {
+fn inner_sum_occluded<T: Real, O: Occluder<T> + ?Sized>(
+    p: [T; 3],
+    n: [T; 3],
+    cols: Columns<'_, T>,
+    occluders: &O,
+) -> T {
     let (bx, by, bz, bnx, bny, bnz, bw) = cols;
     let pv = crate::vec3::vec3(p[0], p[1], p[2]);
     let mut inner = T::ZERO;

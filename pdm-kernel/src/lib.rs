@@ -55,19 +55,19 @@ pub mod surface;
 pub mod vec3;
 pub mod visibility;
 
+pub use adaptive::{adaptive_exchange, Adaptive, Estimate};
+pub use boundary::{boundary_exchange, boundary_exchange_counted};
 pub use dual::{Dual, Scalar};
 pub use error::PdmError;
 pub use form_factor::{exchange, form_factor, form_factor_between, self_form_factor, surface_form_factor, Quadrature};
 pub use gauss::{GaussRule, MAX_ORDER};
-pub use adaptive::{adaptive_exchange, Adaptive, Estimate};
-pub use boundary::{boundary_exchange, boundary_exchange_counted};
 pub use pair::{pair_exchange, PairSettings};
 pub use patch::{Patch, PatchGrid};
 pub use real::Real;
 pub use samples::{Ball, PatchSamples, Sample};
 pub use singular::{classify, classify_near, touching_exchange, Adjacency, SquareMap};
 pub use surface::{
-    AutoNormal, BezierPatch, Cone, Cylinder, Disk, Flipped, Frame, ParamRect, Parallelogram, ParametricMap, Side,
+    AutoNormal, BezierPatch, Cone, Cylinder, Disk, Flipped, Frame, Parallelogram, ParamRect, ParametricMap, Side,
     Sphere, Surface,
 };
 pub use vec3::{vec3, Vec3};

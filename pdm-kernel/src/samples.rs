@@ -227,7 +227,15 @@ impl<T: Real, const CAP: usize> PatchSamples<T, CAP> {
     #[allow(clippy::type_complexity)]
     pub(crate) fn columns(&self) -> (&[T], &[T], &[T], &[T], &[T], &[T], &[T]) {
         let n = self.len;
-        (cut(&self.x, n), cut(&self.y, n), cut(&self.z, n), cut(&self.nx, n), cut(&self.ny, n), cut(&self.nz, n), cut(&self.w, n))
+        (
+            cut(&self.x, n),
+            cut(&self.y, n),
+            cut(&self.z, n),
+            cut(&self.nx, n),
+            cut(&self.ny, n),
+            cut(&self.nz, n),
+            cut(&self.w, n),
+        )
     }
 }
 

@@ -502,7 +502,9 @@ where
                     let (zp, zq, zr) = (zeta * p, zeta * q, zeta * r);
                     let mut k = T::ZERO;
                     // Four pyramids: the largest of (ξ_a, η_a, ξ_b, η_b) is ζ.
-                    for (xa, ya, xb, yb) in [(zeta, zp, zq, zr), (zp, zeta, zq, zr), (zp, zq, zeta, zr), (zp, zq, zr, zeta)] {
+                    for (xa, ya, xb, yb) in
+                        [(zeta, zp, zq, zr), (zp, zeta, zq, zr), (zp, zq, zeta, zr), (zp, zq, zr, zeta)]
+                    {
                         let (pa, na) = a.eval(xa, ya);
                         let (pb, nb) = b.eval(xb, yb);
                         k += kernel(pa, na, pb, nb, occ);

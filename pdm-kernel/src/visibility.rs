@@ -423,6 +423,7 @@ mod tests {
         let a = Ball { center: vec3(0.0, 5.0, -3.0), radius: 0.5 };
         let b = Ball { center: vec3(0.0, 5.0, 3.0), radius: 0.5 };
         assert!(!s.may_block_between(&a, &b));
-        assert!(far.may_block_between(&Ball { center: p, radius: 0.5 }, &Ball { center: vec3(0.0, 13.0, 0.0), radius: 0.1 }));
+        assert!(far
+            .may_block_between(&Ball { center: p, radius: 0.5 }, &Ball { center: vec3(0.0, 13.0, 0.0), radius: 0.1 }));
     }
 }

@@ -40,8 +40,7 @@ fn run() -> Result<ExitCode, Box<dyn std::error::Error>> {
     let shown = path.display();
 
     if check {
-        let committed =
-            std::fs::read_to_string(&path).map_err(|e| format!("cannot read {shown}: {e}"))?;
+        let committed = std::fs::read_to_string(&path).map_err(|e| format!("cannot read {shown}: {e}"))?;
         return Ok(match gauss_gen::first_difference(&committed, &text) {
             None => {
                 println!("{shown} is up to date");

@@ -6,9 +6,7 @@ use std::io::Write as _;
 use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use pdm_host::validate::{
-    self, report::Report, Mode, Outcome, PaperValues, RunConfig, ValidateError,
-};
+use pdm_host::validate::{self, report::Report, Mode, Outcome, PaperValues, RunConfig, ValidateError};
 use pdm_kernel::MAX_ORDER;
 
 /// Exit code for bad command-line input.
@@ -64,10 +62,8 @@ enum Format {
 /// Face numbering: 1: z=+3, 6: z=-3 (the faces holding the poles of the sphere's
 /// parameterisation), 2: y=-3, 3: y=+3, 4: x=-3, 5: x=+3; opposite pairs 1-6, 2-3, 4-5.
 #[derive(Args, Debug)]
-#[command(
-    after_help = "Faces: 1: z=+3, 6: z=-3 (the sphere's poles face these), 2: y=-3, 3: y=+3, \
-4: x=-3, 5: x=+3. Cube side 6 centred at the origin, sphere of radius R at the centre."
-)]
+#[command(after_help = "Faces: 1: z=+3, 6: z=-3 (the sphere's poles face these), 2: y=-3, 3: y=+3, \
+4: x=-3, 5: x=+3. Cube side 6 centred at the origin, sphere of radius R at the centre.")]
 struct ValidateArgs {
     /// Method.
     #[arg(long, value_enum, default_value_t = ModeArg::Paper)]
@@ -120,10 +116,7 @@ fn parse_patches(s: &str) -> Result<usize, String> {
     match s.trim() {
         "86" => Ok(86),
         "280" => Ok(280),
-        _ => Err(
-            "the paper's discretisations are 86 and 280 (use --sphere-grid/--face-grid for others)"
-                .into(),
-        ),
+        _ => Err("the paper's discretisations are 86 and 280 (use --sphere-grid/--face-grid for others)".into()),
     }
 }
 
@@ -154,9 +147,7 @@ fn parse_threads(s: &str) -> Result<usize, String> {
 fn parse_radius(s: &str) -> Result<f64, String> {
     match s.trim().parse::<f64>() {
         Ok(r) if (0.0..3.0).contains(&r) => Ok(r),
-        Ok(_) => Err(
-            "the sphere radius must satisfy 0 <= R < 3 (the sphere must fit in the cube)".into(),
-        ),
+        Ok(_) => Err("the sphere radius must satisfy 0 <= R < 3 (the sphere must fit in the cube)".into()),
         Err(_) => Err("not a number".into()),
     }
 }
@@ -194,10 +185,7 @@ fn clap_error(e: &clap::Error) -> ExitCode {
 /// The first line of a clap error, with its "[possible values: …]" line appended if any.
 fn one_line(text: &str) -> String {
     let mut lines = text.lines().map(str::trim).filter(|l| !l.is_empty());
-    let mut line = lines
-        .next()
-        .unwrap_or("error: invalid arguments")
-        .to_string();
+    let mut line = lines.next().unwrap_or("error: invalid arguments").to_string();
     if let Some(values) = lines.find(|l| l.starts_with("[possible values:")) {
         line.push(' ');
         line.push_str(values);
@@ -212,10 +200,7 @@ fn run_validate(args: &ValidateArgs) -> ExitCode {
     };
     let (sphere_grid, face_grid) = match args.patches {
         Some(280) => ((8, 8), 6),
-        _ => (
-            args.sphere_grid.unwrap_or((4, 8)),
-            args.face_grid.unwrap_or(3),
-        ),
+        _ => (args.sphere_grid.unwrap_or((4, 8)), args.face_grid.unwrap_or(3)),
     };
     let order = args.order.unwrap_or(match mode {
         Mode::Paper => 5,
@@ -238,10 +223,7 @@ fn run_validate(args: &ValidateArgs) -> ExitCode {
         Mode::Accurate => 1,
     });
     if args.threads > 0 {
-        if let Err(e) = rayon::ThreadPoolBuilder::new()
-            .num_threads(args.threads)
-            .build_global()
-        {
+        if let Err(e) = rayon::ThreadPoolBuilder::new().num_threads(args.threads).build_global() {
             eprintln!("error: cannot start {} worker threads: {e}", args.threads);
             return ExitCode::from(EXIT_FAILURE);
         }
@@ -270,11 +252,7 @@ fn run_validate(args: &ValidateArgs) -> ExitCode {
             Err(e) => {
                 bar.finish();
                 eprintln!("error: {e}");
-                let code = if matches!(e, ValidateError::BadSetting(_)) {
-                    EXIT_USAGE
-                } else {
-                    EXIT_FAILURE
-                };
+                let code = if matches!(e, ValidateError::BadSetting(_)) { EXIT_USAGE } else { EXIT_FAILURE };
                 return ExitCode::from(code);
             }
         }
@@ -301,11 +279,7 @@ fn run_validate(args: &ValidateArgs) -> ExitCode {
         },
     };
     let mut stdout = std::io::stdout().lock();
-    if stdout
-        .write_all(text.as_bytes())
-        .and_then(|()| stdout.flush())
-        .is_err()
-    {
+    if stdout.write_all(text.as_bytes()).and_then(|()| stdout.flush()).is_err() {
         return ExitCode::from(EXIT_FAILURE);
     }
     ExitCode::SUCCESS

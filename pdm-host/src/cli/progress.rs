@@ -23,26 +23,17 @@ impl Bar {
     /// A bar over `total` units.
     pub fn new(total: u64) -> Self {
         let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::hidden());
-        if let Ok(style) = ProgressStyle::with_template(
-            "{msg:<15} [{bar:30}] {pos}/{len} patches, {elapsed} (eta {eta})",
-        ) {
+        if let Ok(style) =
+            ProgressStyle::with_template("{msg:<15} [{bar:30}] {pos}/{len} patches, {elapsed} (eta {eta})")
+        {
             bar.set_style(style.progress_chars("=> "));
         }
-        Self {
-            bar,
-            start: Instant::now(),
-            terminal: std::io::stderr().is_terminal(),
-            shown: AtomicBool::new(false),
-        }
+        Self { bar, start: Instant::now(), terminal: std::io::stderr().is_terminal(), shown: AtomicBool::new(false) }
     }
 
     fn maybe_show(&self) {
-        if self.terminal
-            && self.start.elapsed() > SHOW_AFTER
-            && !self.shown.swap(true, Ordering::Relaxed)
-        {
-            self.bar
-                .set_draw_target(ProgressDrawTarget::stderr_with_hz(8));
+        if self.terminal && self.start.elapsed() > SHOW_AFTER && !self.shown.swap(true, Ordering::Relaxed) {
+            self.bar.set_draw_target(ProgressDrawTarget::stderr_with_hz(8));
         }
     }
 

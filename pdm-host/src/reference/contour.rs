@@ -92,9 +92,7 @@ pub fn polygon_form_factor(p1: &[[f64; 3]], p2: &[[f64; 3]]) -> f64 {
     if !(size > 0.0 && size.is_finite()) {
         return f64::NAN;
     }
-    let normalise = |p: &[[f64; 3]]| -> Vec<V3> {
-        p.iter().map(|v| scale(sub(*v, centroid), 1.0 / size)).collect()
-    };
+    let normalise = |p: &[[f64; 3]]| -> Vec<V3> { p.iter().map(|v| scale(sub(*v, centroid), 1.0 / size)).collect() };
     let q1 = normalise(p1);
     let q2 = normalise(p2);
     let a1 = polygon_area(&q1);
@@ -145,8 +143,8 @@ pub(crate) fn edge_pair_log_integral(rule: &GaussLegendre, p: V3, d1: V3, q: V3,
         // comparable; farther apart the inner closed form with the adaptive outer rule below is
         // used (smooth there).
         if eta * eta + gap * gap <= l1 * l2 && xb > xa {
-            let val = -(k_parallel(xb - l2, eta) - k_parallel(xb, eta) - k_parallel(xa - l2, eta)
-                + k_parallel(xa, eta));
+            let val =
+                -(k_parallel(xb - l2, eta) - k_parallel(xb, eta) - k_parallel(xa - l2, eta) + k_parallel(xa, eta));
             return val / ((xb - xa) * l2);
         }
     }
@@ -223,8 +221,7 @@ mod tests {
     fn k_second_derivative_is_half_log() {
         for &(u, eta) in &[(0.7, 0.3), (-1.2, 0.05), (2.0, 0.0), (0.3, 1.5)] {
             let h: f64 = 1e-3;
-            let d2 = (k_parallel(u + h, eta) - 2.0 * k_parallel(u, eta) + k_parallel(u - h, eta))
-                / (h * h);
+            let d2 = (k_parallel(u + h, eta) - 2.0 * k_parallel(u, eta) + k_parallel(u - h, eta)) / (h * h);
             let expect = 0.5 * (u * u + eta * eta).ln();
             assert!((d2 - expect).abs() < 1e-5, "{u} {eta} {d2} {expect}");
         }

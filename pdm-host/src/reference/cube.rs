@@ -298,11 +298,8 @@ fn pair_setup(side: f64, radius: f64, face_a: usize, face_b: usize) -> Option<Se
     }
     let opposite = dot(fa.normal, fb.normal) < -0.5;
     // C-11 (opposite) or C-14 (adjacent) for l × l squares
-    let unoccluded = if opposite {
-        parallel_rectangles(side, side, side)
-    } else {
-        perpendicular_rectangles(side, side, side)
-    };
+    let unoccluded =
+        if opposite { parallel_rectangles(side, side, side) } else { perpendicular_rectangles(side, side, side) };
     if radius == 0.0 {
         return Some(Setup::Done(FaceFactor { value: unoccluded, error: 0.0 }));
     }
@@ -353,11 +350,7 @@ impl Conic {
 
     /// `s` where the conic crosses the line `t = t_fixed`.
     fn crossing_s(&self, t_fixed: f64) -> (usize, [f64; 2]) {
-        quadratic_roots(
-            self.css,
-            self.cst * t_fixed + self.cs,
-            (self.ctt * t_fixed + self.ct) * t_fixed + self.c0,
-        )
+        quadratic_roots(self.css, self.cst * t_fixed + self.cs, (self.ctt * t_fixed + self.ct) * t_fixed + self.c0)
     }
 }
 
@@ -452,9 +445,7 @@ fn line_integral(fa: &FaceFrame, events: &[Conic], inner: &Inner<'_>, sa: f64, t
         push_roots(&mut sing, ev.roots_t(sa));
     }
     let base = axpy(fa.centre, sa, fa.e1);
-    inner.rule.integrate_graded(t_lo, inner.h, &mut sing, |ta| {
-        inner.blocked_integral(axpy(base, ta, fa.e2))
-    })
+    inner.rule.integrate_graded(t_lo, inner.h, &mut sing, |ta| inner.blocked_integral(axpy(base, ta, fa.e2)))
 }
 
 /// The inner integral over face b, for one outer point.

@@ -161,11 +161,7 @@ fn cosine_direction(rng: &mut Xoshiro256, n: [f64; 3], u: [f64; 3], v: [f64; 3])
     let rad = r1.sqrt();
     let (a, b) = (rad * phi.cos(), rad * phi.sin());
     let c = (1.0 - r1).max(0.0).sqrt();
-    [
-        a * u[0] + b * v[0] + c * n[0],
-        a * u[1] + b * v[1] + c * n[1],
-        a * u[2] + b * v[2] + c * n[2],
-    ]
+    [a * u[0] + b * v[0] + c * n[0], a * u[1] + b * v[1] + c * n[1], a * u[2] + b * v[2] + c * n[2]]
 }
 
 /// Rays from the face `face` (uniform point, cosine-weighted direction): hit counters.
@@ -283,11 +279,7 @@ fn estimate(hits: u64, rays: u64, share: f64) -> McEstimate {
         return McEstimate { value: f64::NAN, std_error: f64::NAN, rays };
     }
     let p = hits as f64 / rays as f64;
-    McEstimate {
-        value: p / share,
-        std_error: (p * (1.0 - p) / rays as f64).sqrt() / share,
-        rays,
-    }
+    McEstimate { value: p / share, std_error: (p * (1.0 - p) / rays as f64).sqrt() / share, rays }
 }
 
 fn valid(side: f64, radius: f64) -> bool {
@@ -316,14 +308,7 @@ pub fn mc_cube_factors(side: f64, radius: f64, rays: u64, seed: u64) -> Option<M
 
 /// Estimate of the form factor from face `face_a` to face `face_b` (or to the sphere when
 /// `face_b == 0`). `None` for invalid faces or geometry.
-pub fn mc_face_pair(
-    side: f64,
-    radius: f64,
-    face_a: usize,
-    face_b: usize,
-    rays: u64,
-    seed: u64,
-) -> Option<McEstimate> {
+pub fn mc_face_pair(side: f64, radius: f64, face_a: usize, face_b: usize, rays: u64, seed: u64) -> Option<McEstimate> {
     if !valid(side, radius) || face_b > 6 {
         return None;
     }

@@ -105,14 +105,7 @@ impl GaussLegendre {
     /// total (a guard against unattainable tolerances). Returns the sum of the accepted
     /// half-interval values and the sum of the differences (a conservative error estimate: the
     /// accepted value is the finer of the two).
-    pub fn adaptive<F: FnMut(f64) -> f64>(
-        &self,
-        a: f64,
-        b: f64,
-        tol: f64,
-        max_depth: u32,
-        f: &mut F,
-    ) -> (f64, f64) {
+    pub fn adaptive<F: FnMut(f64) -> f64>(&self, a: f64, b: f64, tol: f64, max_depth: u32, f: &mut F) -> (f64, f64) {
         let whole = self.integrate_with_abs(a, b, f).0;
         let mut budget: u32 = 1 << 16;
         self.adaptive_rec(a, b, whole, tol, max_depth, &mut budget, f)
@@ -153,13 +146,7 @@ impl GaussLegendre {
     /// to their distance from that point), and each sub-piece is integrated with the
     /// cosine-mapped rule [`GaussLegendre::integrate_cos`]. Singular points closer than
     /// `1e-7·(hi − lo)` are merged. The list is sorted in place.
-    pub fn integrate_graded<F: FnMut(f64) -> f64>(
-        &self,
-        lo: f64,
-        hi: f64,
-        singular: &mut Vec<f64>,
-        mut f: F,
-    ) -> f64 {
+    pub fn integrate_graded<F: FnMut(f64) -> f64>(&self, lo: f64, hi: f64, singular: &mut Vec<f64>, mut f: F) -> f64 {
         if !(hi > lo) {
             return 0.0;
         }
@@ -180,16 +167,8 @@ impl GaussLegendre {
             let [a, b] = *w else { continue };
             let len = b - a;
             // nearest singular points strictly outside the piece
-            let d_left = singular
-                .iter()
-                .filter(|x| **x < a - tiny)
-                .map(|x| a - *x)
-                .fold(f64::INFINITY, f64::min);
-            let d_right = singular
-                .iter()
-                .filter(|x| **x > b + tiny)
-                .map(|x| *x - b)
-                .fold(f64::INFINITY, f64::min);
+            let d_left = singular.iter().filter(|x| **x < a - tiny).map(|x| a - *x).fold(f64::INFINITY, f64::min);
+            let d_right = singular.iter().filter(|x| **x > b + tiny).map(|x| *x - b).fold(f64::INFINITY, f64::min);
             let mut cuts: Vec<f64> = Vec::new();
             let mid = 0.5 * (a + b);
             if d_left < 0.5 * len {

@@ -6,8 +6,7 @@
 use std::time::Instant;
 
 use pdm_kernel::{
-    form_factor, pair_exchange, PairSettings, Parallelogram, Patch, PatchGrid, PatchSamples,
-    PdmError, Real, Sphere,
+    form_factor, pair_exchange, PairSettings, Parallelogram, Patch, PatchGrid, PatchSamples, PdmError, Real, Sphere,
 };
 use rayon::prelude::*;
 
@@ -50,11 +49,7 @@ fn kernel(context: &'static str) -> impl Fn(PdmError) -> ValidateError {
 #[must_use]
 pub fn work_units(cfg: &RunConfig) -> u64 {
     let face_patches = cfg.face_grid * cfg.face_grid;
-    let sphere = if cfg.radius > 0.0 {
-        6 * cfg.sphere_grid.0 * cfg.sphere_grid.1
-    } else {
-        0
-    };
+    let sphere = if cfg.radius > 0.0 { 6 * cfg.sphere_grid.0 * cfg.sphere_grid.1 } else { 0 };
     (sphere + FACE_PAIRS.len() * face_patches) as u64
 }
 
@@ -67,11 +62,7 @@ pub fn run_once<T: Real, const CAP: usize>(
     let k = cfg.face_grid;
     let mut face_patches: Vec<Vec<Patch<'_, T, Face<T>>>> = Vec::with_capacity(6);
     for face in &scene.faces {
-        face_patches.push(
-            PatchGrid::new(face, k, k)
-                .map_err(kernel("face grid"))?
-                .collect(),
-        );
+        face_patches.push(PatchGrid::new(face, k, k).map_err(kernel("face grid"))?.collect());
     }
 
     // Part 1: sphere → face (Table 1), eq. (25).
@@ -80,16 +71,11 @@ pub fn run_once<T: Real, const CAP: usize>(
         Some(sphere) => {
             progress.stage("sphere -> face");
             let (m, n) = cfg.sphere_grid;
-            let sphere_patches: Vec<Patch<'_, T, Sphere<T>>> = PatchGrid::new(sphere, m, n)
-                .map_err(kernel("sphere grid"))?
-                .collect();
+            let sphere_patches: Vec<Patch<'_, T, Sphere<T>>> =
+                PatchGrid::new(sphere, m, n).map_err(kernel("sphere grid"))?.collect();
             Some(match cfg.mode {
-                Mode::Paper => {
-                    paper_sphere_face::<T, CAP>(cfg, &sphere_patches, &face_patches, progress)?
-                }
-                Mode::Accurate => {
-                    accurate_sphere_face::<T, CAP>(cfg, &sphere_patches, &face_patches, progress)?
-                }
+                Mode::Paper => paper_sphere_face::<T, CAP>(cfg, &sphere_patches, &face_patches, progress)?,
+                Mode::Accurate => accurate_sphere_face::<T, CAP>(cfg, &sphere_patches, &face_patches, progress)?,
             })
         }
         None => None,
@@ -101,20 +87,12 @@ pub fn run_once<T: Real, const CAP: usize>(
     let start = Instant::now();
     let (face_exchange, face_area) = match cfg.mode {
         Mode::Paper => paper_face_face::<T, CAP>(cfg, &scene.sphere, &face_patches, progress)?,
-        Mode::Accurate => {
-            accurate_face_face::<T, CAP>(cfg, &scene.sphere, &face_patches, progress)?
-        }
+        Mode::Accurate => accurate_face_face::<T, CAP>(cfg, &scene.sphere, &face_patches, progress)?,
     };
     let face_face_seconds = start.elapsed().as_secs_f64();
 
     let values = derive(part1, &face_exchange, &face_area)?;
-    Ok((
-        values,
-        Times {
-            sphere_face: sphere_face_seconds,
-            face_face: face_face_seconds,
-        },
-    ))
+    Ok((values, Times { sphere_face: sphere_face_seconds, face_face: face_face_seconds }))
 }
 
 /// Exchange sums per face (Σ A_ps F_ps→pf over the face's patches) and the sphere's area.
@@ -133,11 +111,7 @@ fn derive<T: Real>(
     let area_of = |f: usize| face_area.get(f.wrapping_sub(1)).copied().unwrap_or(T::ZERO);
     let mut face_to_face = [0.0; 15];
     let mut sums = [T::ZERO; 6];
-    for ((&(a, b), &e), out) in FACE_PAIRS
-        .iter()
-        .zip(face_exchange)
-        .zip(face_to_face.iter_mut())
-    {
+    for ((&(a, b), &e), out) in FACE_PAIRS.iter().zip(face_exchange).zip(face_to_face.iter_mut()) {
         *out = (e / area_of(a)).to_f64();
         if let Some(s) = sums.get_mut(a - 1) {
             *s += e / area_of(a);
@@ -153,9 +127,7 @@ fn derive<T: Real>(
             for (f, &e) in p.exchange.iter().enumerate() {
                 let fa = p.face_area.get(f).copied().unwrap_or(T::ZERO);
                 let to_sphere = e / fa;
-                if let (Some(x), Some(y), Some(s)) =
-                    (s2f.get_mut(f), f2s.get_mut(f), sums.get_mut(f))
-                {
+                if let (Some(x), Some(y), Some(s)) = (s2f.get_mut(f), f2s.get_mut(f), sums.get_mut(f)) {
                     *x = (e / p.sphere_area).to_f64();
                     *y = to_sphere.to_f64();
                     *s += to_sphere;
@@ -166,15 +138,9 @@ fn derive<T: Real>(
         None => (None, None, None),
     };
     let face_sum = sums.map(Real::to_f64);
-    let all = face_to_face
-        .iter()
-        .chain(&face_sum)
-        .chain(sphere_to_face.iter().flatten());
+    let all = face_to_face.iter().chain(&face_sum).chain(sphere_to_face.iter().flatten());
     if all.clone().any(|x| !x.is_finite()) {
-        return Err(ValidateError::Kernel {
-            context: "summing the patch factors",
-            error: PdmError::InvalidResult,
-        });
+        return Err(ValidateError::Kernel { context: "summing the patch factors", error: PdmError::InvalidResult });
     }
     Ok(Values {
         sphere_to_face,
@@ -203,10 +169,7 @@ fn sample_all<T: Real, S: pdm_kernel::Surface<T> + Sync + ?Sized, const CAP: usi
     patches: &[Patch<'_, T, S>],
     order: usize,
 ) -> Result<Vec<PatchSamples<T, CAP>>, ValidateError> {
-    patches
-        .par_iter()
-        .map(|p| PatchSamples::<T, CAP>::new(p, order).map_err(kernel("sampling a patch")))
-        .collect()
+    patches.par_iter().map(|p| PatchSamples::<T, CAP>::new(p, order).map_err(kernel("sampling a patch"))).collect()
 }
 
 fn total_area<T: Real, const CAP: usize>(samples: &[PatchSamples<T, CAP>]) -> T {
@@ -226,22 +189,16 @@ fn paper_sphere_face<T: Real, const CAP: usize>(
     progress: &dyn Progress,
 ) -> Result<SpherePart<T>, ValidateError> {
     let ss = sample_all::<T, Sphere<T>, CAP>(sphere_patches, cfg.order)?;
-    let fs = face_patches
-        .iter()
-        .map(|f| sample_all::<T, Face<T>, CAP>(f, cfg.order))
-        .collect::<Result<Vec<_>, _>>()?;
-    let tasks: Vec<(&PatchSamples<T, CAP>, &[PatchSamples<T, CAP>])> = fs
-        .iter()
-        .flat_map(|face| ss.iter().map(move |s| (s, face.as_slice())))
-        .collect();
+    let fs = face_patches.iter().map(|f| sample_all::<T, Face<T>, CAP>(f, cfg.order)).collect::<Result<Vec<_>, _>>()?;
+    let tasks: Vec<(&PatchSamples<T, CAP>, &[PatchSamples<T, CAP>])> =
+        fs.iter().flat_map(|face| ss.iter().map(move |s| (s, face.as_slice()))).collect();
     let partial = tasks
         .par_iter()
         .map(|&(sa, face)| {
             let mut acc = T::ZERO;
             for sb in face {
                 // Eq. (25): A_ps · F_ps→pf.
-                acc += form_factor(sa, sb, &()).map_err(kernel("sphere patch -> face patch"))?
-                    * sa.area();
+                acc += form_factor(sa, sb, &()).map_err(kernel("sphere patch -> face patch"))? * sa.area();
             }
             progress.advance(1);
             Ok(acc)
@@ -251,11 +208,7 @@ fn paper_sphere_face<T: Real, const CAP: usize>(
     for (a, f) in face_area.iter_mut().zip(&fs) {
         *a = total_area(f);
     }
-    Ok(SpherePart {
-        exchange: chunk_sums(&partial, ss.len()),
-        sphere_area: total_area(&ss),
-        face_area,
-    })
+    Ok(SpherePart { exchange: chunk_sums(&partial, ss.len()), sphere_area: total_area(&ss), face_area })
 }
 
 /// Paper mode, part 2: eq. (26) with plain eq. (16) sums, the sphere as occluder; edge-adjacent
@@ -267,10 +220,7 @@ fn paper_face_face<T: Real, const CAP: usize>(
     face_patches: &[Vec<Patch<'_, T, Face<T>>>],
     progress: &dyn Progress,
 ) -> Result<([T; 15], [T; 6]), ValidateError> {
-    let fs = face_patches
-        .iter()
-        .map(|f| sample_all::<T, Face<T>, CAP>(f, cfg.order))
-        .collect::<Result<Vec<_>, _>>()?;
+    let fs = face_patches.iter().map(|f| sample_all::<T, Face<T>, CAP>(f, cfg.order)).collect::<Result<Vec<_>, _>>()?;
     let per_pair = cfg.face_grid * cfg.face_grid;
     let mut tasks: Vec<(&PatchSamples<T, CAP>, &[PatchSamples<T, CAP>])> = Vec::new();
     for &(a, b) in &FACE_PAIRS {
@@ -283,8 +233,7 @@ fn paper_face_face<T: Real, const CAP: usize>(
         .map(|&(sa, face_b)| {
             let mut acc = T::ZERO;
             for sb in face_b {
-                acc += form_factor(sa, sb, sphere).map_err(kernel("face patch -> face patch"))?
-                    * sa.area();
+                acc += form_factor(sa, sb, sphere).map_err(kernel("face patch -> face patch"))? * sa.area();
             }
             progress.advance(1);
             Ok(acc)
@@ -298,21 +247,15 @@ fn paper_face_face<T: Real, const CAP: usize>(
 }
 
 fn settings(cfg: &RunConfig) -> PairSettings {
-    PairSettings {
-        order: cfg.order,
-        singular_order: cfg.singular_order,
-        boundaries: true,
-    }
+    PairSettings { order: cfg.order, singular_order: cfg.singular_order, boundaries: true }
 }
 
 fn areas<T: Real, S: pdm_kernel::Surface<T> + Sync + ?Sized>(
     patches: &[Patch<'_, T, S>],
     order: usize,
 ) -> Result<T, ValidateError> {
-    let each = patches
-        .par_iter()
-        .map(|p| p.area(order).map_err(kernel("patch area")))
-        .collect::<Result<Vec<T>, _>>()?;
+    let each =
+        patches.par_iter().map(|p| p.area(order).map_err(kernel("patch area"))).collect::<Result<Vec<T>, _>>()?;
     let mut a = T::ZERO;
     for x in each {
         a += x;
@@ -330,17 +273,15 @@ fn accurate_sphere_face<T: Real, const CAP: usize>(
 ) -> Result<SpherePart<T>, ValidateError> {
     let set = settings(cfg);
     type Task<'a, 'p, T> = (&'a Patch<'p, T, Sphere<T>>, &'a [Patch<'p, T, Face<T>>]);
-    let tasks: Vec<Task<'_, '_, T>> = face_patches
-        .iter()
-        .flat_map(|face| sphere_patches.iter().map(move |s| (s, face.as_slice())))
-        .collect();
+    let tasks: Vec<Task<'_, '_, T>> =
+        face_patches.iter().flat_map(|face| sphere_patches.iter().map(move |s| (s, face.as_slice()))).collect();
     let partial = tasks
         .par_iter()
         .map(|&(ps, face)| {
             let mut acc = T::ZERO;
             for pf in face {
-                acc += pair_exchange::<T, _, _, _, CAP>(ps, pf, set, &())
-                    .map_err(kernel("sphere patch -> face patch"))?;
+                acc +=
+                    pair_exchange::<T, _, _, _, CAP>(ps, pf, set, &()).map_err(kernel("sphere patch -> face patch"))?;
             }
             progress.advance(1);
             Ok(acc)

@@ -96,41 +96,21 @@ pub struct RunConfig {
 impl RunConfig {
     /// Checks every setting; the error names the bad value.
     pub fn check(&self) -> Result<(), ValidateError> {
-        let bad = |what: &str, value: String, why: &str| {
-            Err(ValidateError::BadSetting(format!("{what} {value}: {why}")))
-        };
+        let bad =
+            |what: &str, value: String, why: &str| Err(ValidateError::BadSetting(format!("{what} {value}: {why}")));
         if !(self.radius >= 0.0 && self.radius < 3.0) {
-            return bad(
-                "sphere radius",
-                format!("{}", self.radius),
-                "must satisfy 0 <= R < 3 (0 = no sphere)",
-            );
+            return bad("sphere radius", format!("{}", self.radius), "must satisfy 0 <= R < 3 (0 = no sphere)");
         }
         if !(1..=MAX_FACE_GRID).contains(&self.face_grid) {
-            return bad(
-                "face grid",
-                self.face_grid.to_string(),
-                &format!("must be in 1..={MAX_FACE_GRID}"),
-            );
+            return bad("face grid", self.face_grid.to_string(), &format!("must be in 1..={MAX_FACE_GRID}"));
         }
         let (m, n) = self.sphere_grid;
         if !(1..=MAX_SPHERE_GRID).contains(&m) || !(1..=MAX_SPHERE_GRID).contains(&n) {
-            return bad(
-                "sphere grid",
-                format!("{m}x{n}"),
-                &format!("both must be in 1..={MAX_SPHERE_GRID}"),
-            );
+            return bad("sphere grid", format!("{m}x{n}"), &format!("both must be in 1..={MAX_SPHERE_GRID}"));
         }
-        for (what, o) in [
-            ("order", self.order),
-            ("singular order", self.singular_order),
-        ] {
+        for (what, o) in [("order", self.order), ("singular order", self.singular_order)] {
             if !(1..=MAX_ORDER).contains(&o) {
-                return bad(
-                    what,
-                    o.to_string(),
-                    &format!("Gauss order must be in 1..={MAX_ORDER}"),
-                );
+                return bad(what, o.to_string(), &format!("Gauss order must be in 1..={MAX_ORDER}"));
             }
         }
         Ok(())
@@ -234,12 +214,7 @@ impl Outcome {
     /// Median wall time of a whole computation (both parts).
     #[must_use]
     pub fn total_seconds(&self) -> f64 {
-        median(
-            self.times
-                .iter()
-                .map(|t| t.sphere_face + t.face_face)
-                .collect(),
-        )
+        median(self.times.iter().map(|t| t.sphere_face + t.face_face).collect())
     }
 }
 
@@ -255,17 +230,9 @@ pub fn median(mut xs: Vec<f64>) -> f64 {
 }
 
 /// Runs the computation `repeat` times (at least once) in precision `T`.
-pub fn run<T: Real>(
-    cfg: &RunConfig,
-    repeat: usize,
-    progress: &dyn Progress,
-) -> Result<Outcome, ValidateError> {
+pub fn run<T: Real>(cfg: &RunConfig, repeat: usize, progress: &dyn Progress) -> Result<Outcome, ValidateError> {
     cfg.check()?;
-    let precision = if T::MANTISSA_DIGITS == 24 {
-        Precision::F32
-    } else {
-        Precision::F64
-    };
+    let precision = if T::MANTISSA_DIGITS == 24 { Precision::F32 } else { Precision::F64 };
     let mut times = Vec::new();
     let mut last = None;
     for _ in 0..repeat.max(1) {
@@ -274,22 +241,13 @@ pub fn run<T: Real>(
         last = Some(values);
     }
     match last {
-        Some(values) => Ok(Outcome {
-            precision,
-            values,
-            times,
-        }),
-        None => Err(ValidateError::BadSetting(
-            "repeat 0: must be at least 1".into(),
-        )),
+        Some(values) => Ok(Outcome { precision, values, times }),
+        None => Err(ValidateError::BadSetting("repeat 0: must be at least 1".into())),
     }
 }
 
 /// Picks the sample capacity for the order (CAP ≥ order²).
-fn run_dispatch<T: Real>(
-    cfg: &RunConfig,
-    progress: &dyn Progress,
-) -> Result<(Values, Times), ValidateError> {
+fn run_dispatch<T: Real>(cfg: &RunConfig, progress: &dyn Progress) -> Result<(Values, Times), ValidateError> {
     use compute::run_once;
     match cfg.order * cfg.order {
         0..=25 => run_once::<T, 25>(cfg, progress),
@@ -306,21 +264,8 @@ fn run_dispatch<T: Real>(
 mod tests {
     use super::*;
 
-    fn cfg(
-        mode: Mode,
-        sphere_grid: (usize, usize),
-        k: usize,
-        order: usize,
-        radius: f64,
-    ) -> RunConfig {
-        RunConfig {
-            mode,
-            sphere_grid,
-            face_grid: k,
-            order,
-            singular_order: 8,
-            radius,
-        }
+    fn cfg(mode: Mode, sphere_grid: (usize, usize), k: usize, order: usize, radius: f64) -> RunConfig {
+        RunConfig { mode, sphere_grid, face_grid: k, order, singular_order: 8, radius }
     }
 
     #[test]
@@ -333,11 +278,7 @@ mod tests {
     #[test]
     fn bad_settings_are_named() {
         let c = cfg(Mode::Paper, (4, 8), 3, 5, 3.0);
-        assert!(c
-            .check()
-            .unwrap_err()
-            .to_string()
-            .contains("sphere radius 3"));
+        assert!(c.check().unwrap_err().to_string().contains("sphere radius 3"));
         let c = cfg(Mode::Paper, (4, 0), 3, 5, 1.0);
         assert!(c.check().unwrap_err().to_string().contains("4x0"));
         let c = cfg(Mode::Paper, (4, 8), 3, 33, 1.0);
@@ -364,14 +305,9 @@ mod tests {
                             }
                         }
                     }
-                    let (free, occluded) = (
-                        form_factor(&sa, &sb, &()).unwrap(),
-                        form_factor(&sa, &sb, &sphere).unwrap(),
-                    );
-                    assert!(
-                        (free - occluded).abs() <= 1e-15 * free,
-                        "{free} vs {occluded}"
-                    );
+                    let (free, occluded) =
+                        (form_factor(&sa, &sb, &()).unwrap(), form_factor(&sa, &sb, &sphere).unwrap());
+                    assert!((free - occluded).abs() <= 1e-15 * free, "{free} vs {occluded}");
                 }
             }
         }
@@ -391,11 +327,7 @@ mod tests {
         assert!((s[0] - s[5]).abs() < 1e-14, "{s:?}");
         let ff = out.values.face_to_face;
         for (k, &(a, b)) in scene::FACE_PAIRS.iter().enumerate() {
-            let same = if scene::is_opposite(a, b) {
-                ff[4]
-            } else {
-                ff[0]
-            };
+            let same = if scene::is_opposite(a, b) { ff[4] } else { ff[0] };
             assert!((ff[k] - same).abs() < 1e-12, "{a}-{b}: {ff:?}");
         }
     }

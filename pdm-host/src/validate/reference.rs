@@ -12,9 +12,7 @@ use std::time::Instant;
 
 use super::scene::{is_opposite, FACE_PAIRS, SIDE};
 use super::ValidateError;
-use crate::reference::closed_form::{
-    cube_face_to_centred_sphere, parallel_rectangles, perpendicular_rectangles,
-};
+use crate::reference::closed_form::{cube_face_to_centred_sphere, parallel_rectangles, perpendicular_rectangles};
 
 /// Where the face → face reference came from.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -68,18 +66,12 @@ impl Reference {
     #[must_use]
     pub fn describe(&self) -> String {
         match &self.source {
-            Source::ClosedForm => {
-                "face -> face: exact, Howell C-11 (opposite) and C-14 (adjacent)".into()
-            }
+            Source::ClosedForm => "face -> face: exact, Howell C-11 (opposite) and C-14 (adjacent)".into(),
             Source::Unavailable(why) => format!("face -> face: unavailable ({why})"),
             Source::Independent | Source::Stored => format!(
                 "face -> face: independent host integration, pdm_host::reference::cube{}; \
                  uncertainty {:.0e} (adjacent), {:.0e} (opposite)",
-                if self.source == Source::Stored {
-                    " (stored; --recompute-reference)"
-                } else {
-                    ""
-                },
+                if self.source == Source::Stored { " (stored; --recompute-reference)" } else { "" },
                 self.adjacent_uncertainty,
                 self.opposite_uncertainty
             ),
@@ -90,34 +82,18 @@ impl Reference {
 /// `cube_face_factors(6, 1)` (adjacent, opposite, their error estimates), stored because it
 /// takes seconds (reproduce: `cargo run --release -p pdm-host --example cube_reference`); `pdm validate --recompute-reference` recomputes it, and the unit test
 /// `stored_reference_matches_cube_module` checks it.
-pub const STORED_R1: (f64, f64, f64, f64) = (
-    0.19689310669952767,
-    0.15424993146874516,
-    6.071532165918825e-18,
-    2.8449465006019636e-16,
-);
+pub const STORED_R1: (f64, f64, f64, f64) =
+    (0.19689310669952767, 0.15424993146874516, 6.071532165918825e-18, 2.8449465006019636e-16);
 
 /// The independent obstructed face → face factors: (adjacent, opposite, their uncertainties),
 /// from [`crate::reference::cube::cube_face_factors`] (side 6).
 fn obstructed(radius: f64) -> Result<(f64, f64, f64, f64), ValidateError> {
     let r = crate::reference::cube::cube_face_factors(SIDE, radius);
-    let all = [
-        r.f_adjacent,
-        r.f_opposite,
-        r.f_adjacent_error,
-        r.f_opposite_error,
-    ];
+    let all = [r.f_adjacent, r.f_opposite, r.f_adjacent_error, r.f_opposite_error];
     if all.iter().all(|x| x.is_finite()) {
-        Ok((
-            r.f_adjacent,
-            r.f_opposite,
-            r.f_adjacent_error,
-            r.f_opposite_error,
-        ))
+        Ok((r.f_adjacent, r.f_opposite, r.f_adjacent_error, r.f_opposite_error))
     } else {
-        Err(ValidateError::Reference(format!(
-            "pdm_host::reference::cube gave no value for R = {radius}"
-        )))
+        Err(ValidateError::Reference(format!("pdm_host::reference::cube gave no value for R = {radius}")))
     }
 }
 
@@ -127,42 +103,27 @@ fn obstructed(radius: f64) -> Result<(f64, f64, f64, f64), ValidateError> {
 #[must_use]
 pub fn compute(radius: f64, recompute: bool) -> Reference {
     let start = Instant::now();
-    let (adjacent, opposite, adjacent_uncertainty, opposite_uncertainty, source) =
-        if radius == 1.0 && !recompute {
-            let (a, o, ua, uo) = STORED_R1;
-            (a, o, ua, uo, Source::Stored)
-        } else if radius > 0.0 {
-            match obstructed(radius) {
-                Ok((a, o, ua, uo)) => (a, o, ua, uo, Source::Independent),
-                Err(e) => (
-                    f64::NAN,
-                    f64::NAN,
-                    f64::NAN,
-                    f64::NAN,
-                    Source::Unavailable(e.to_string()),
-                ),
-            }
-        } else {
-            (
-                perpendicular_rectangles(SIDE, SIDE, SIDE),
-                parallel_rectangles(SIDE, SIDE, SIDE),
-                0.0,
-                0.0,
-                Source::ClosedForm,
-            )
-        };
+    let (adjacent, opposite, adjacent_uncertainty, opposite_uncertainty, source) = if radius == 1.0 && !recompute {
+        let (a, o, ua, uo) = STORED_R1;
+        (a, o, ua, uo, Source::Stored)
+    } else if radius > 0.0 {
+        match obstructed(radius) {
+            Ok((a, o, ua, uo)) => (a, o, ua, uo, Source::Independent),
+            Err(e) => (f64::NAN, f64::NAN, f64::NAN, f64::NAN, Source::Unavailable(e.to_string())),
+        }
+    } else {
+        (
+            perpendicular_rectangles(SIDE, SIDE, SIDE),
+            parallel_rectangles(SIDE, SIDE, SIDE),
+            0.0,
+            0.0,
+            Source::ClosedForm,
+        )
+    };
     let mut face_to_face = [0.0; 15];
     let mut face_to_face_uncertainty = [0.0; 15];
-    for ((&(a, b), f), u) in FACE_PAIRS
-        .iter()
-        .zip(&mut face_to_face)
-        .zip(&mut face_to_face_uncertainty)
-    {
-        (*f, *u) = if is_opposite(a, b) {
-            (opposite, opposite_uncertainty)
-        } else {
-            (adjacent, adjacent_uncertainty)
-        };
+    for ((&(a, b), f), u) in FACE_PAIRS.iter().zip(&mut face_to_face).zip(&mut face_to_face_uncertainty) {
+        (*f, *u) = if is_opposite(a, b) { (opposite, opposite_uncertainty) } else { (adjacent, adjacent_uncertainty) };
     }
     let sphere = radius > 0.0;
     Reference {
@@ -190,11 +151,7 @@ mod tests {
         let r = compute(0.0, false);
         assert!((r.adjacent - 0.2000437760754032).abs() < 1e-15);
         assert!((r.opposite - 0.1998248956983874).abs() < 1e-15);
-        assert!(
-            r.sum_rule_residual().abs() < 1e-14,
-            "{}",
-            r.sum_rule_residual()
-        );
+        assert!(r.sum_rule_residual().abs() < 1e-14, "{}", r.sum_rule_residual());
         assert!(r.sphere_to_face.is_none());
     }
 
@@ -207,10 +164,6 @@ mod tests {
         assert_eq!(stored.source, Source::Stored);
         assert!((fresh.adjacent - stored.adjacent).abs() <= 1e-14 + stored.adjacent_uncertainty);
         assert!((fresh.opposite - stored.opposite).abs() <= 1e-14 + stored.opposite_uncertainty);
-        assert!(
-            stored.sum_rule_residual().abs() < 1e-10,
-            "{}",
-            stored.sum_rule_residual()
-        );
+        assert!(stored.sum_rule_residual().abs() < 1e-10, "{}", stored.sum_rule_residual());
     }
 }

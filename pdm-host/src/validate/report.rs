@@ -36,10 +36,7 @@ pub fn relative_error(ours: f64, reference: f64) -> f64 {
 }
 
 fn rel_errors(ours: &[f64], reference: &[f64]) -> Vec<f64> {
-    ours.iter()
-        .zip(reference)
-        .map(|(&o, &r)| relative_error(o, r))
-        .collect()
+    ours.iter().zip(reference).map(|(&o, &r)| relative_error(o, r)).collect()
 }
 
 fn pair_object(values: &[f64; 15]) -> Value {
@@ -61,22 +58,11 @@ impl Report {
         m.insert("patches_option".into(), json!(self.patches));
         m.insert(
             "sphere_grid".into(),
-            if c.radius > 0.0 {
-                json!([c.sphere_grid.0, c.sphere_grid.1])
-            } else {
-                Value::Null
-            },
+            if c.radius > 0.0 { json!([c.sphere_grid.0, c.sphere_grid.1]) } else { Value::Null },
         );
         m.insert("face_grid".into(), json!(c.face_grid));
         m.insert("order".into(), json!(c.order));
-        m.insert(
-            "singular_order".into(),
-            if c.mode == Mode::Accurate {
-                json!(c.singular_order)
-            } else {
-                Value::Null
-            },
-        );
+        m.insert("singular_order".into(), if c.mode == Mode::Accurate { json!(c.singular_order) } else { Value::Null });
         m.insert("sphere_radius".into(), json!(c.radius));
         m.insert("repeat".into(), json!(self.repeat));
         m.insert("threads".into(), json!(self.threads));
@@ -175,10 +161,7 @@ impl Report {
         };
         let mut top = self.outcome_json(first);
         for o in iter {
-            top.insert(
-                o.precision.name().into(),
-                Value::Object(self.outcome_json(o)),
-            );
+            top.insert(o.precision.name().into(), Value::Object(self.outcome_json(o)));
         }
         Value::Object(top)
     }
@@ -186,23 +169,20 @@ impl Report {
     /// CSV (`--format csv`): one row per value and precision, then timing and setting rows.
     #[must_use]
     pub fn to_csv(&self) -> String {
-        let mut out = String::from(
-            "table,item,precision,paper,ours,reference,relative_error,reference_uncertainty\n",
-        );
+        let mut out = String::from("table,item,precision,paper,ours,reference,relative_error,reference_uncertainty\n");
         let num = |x: Option<f64>| x.map_or(String::new(), |x| format!("{x:e}"));
         let r = &self.reference;
         for o in &self.outcomes {
             let p = o.precision.name();
             let v = &o.values;
-            let mut row =
-                |table: &str, item: String, paper: Option<f64>, ours: f64, re: f64, unc: f64| {
-                    let _ = writeln!(
-                        out,
-                        "{table},{item},{p},{},{ours:e},{re:e},{:e},{unc:e}",
-                        num(paper),
-                        relative_error(ours, re)
-                    );
-                };
+            let mut row = |table: &str, item: String, paper: Option<f64>, ours: f64, re: f64, unc: f64| {
+                let _ = writeln!(
+                    out,
+                    "{table},{item},{p},{},{ours:e},{re:e},{:e},{unc:e}",
+                    num(paper),
+                    relative_error(ours, re)
+                );
+            };
             if let (Some(s), Some(rs)) = (v.sphere_to_face, r.sphere_to_face) {
                 for (f, (&x, &y)) in s.iter().zip(&rs).enumerate() {
                     row(
@@ -224,47 +204,17 @@ impl Report {
                 let (x, y, u) = (
                     v.face_to_face.get(k).copied().unwrap_or(f64::NAN),
                     r.face_to_face.get(k).copied().unwrap_or(f64::NAN),
-                    r.face_to_face_uncertainty
-                        .get(k)
-                        .copied()
-                        .unwrap_or(f64::NAN),
+                    r.face_to_face_uncertainty.get(k).copied().unwrap_or(f64::NAN),
                 );
-                row(
-                    "face_to_face",
-                    pair_key(a, b),
-                    self.paper.map(|pv| pv.face_to_face(a, b)),
-                    x,
-                    y,
-                    u,
-                );
+                row("face_to_face", pair_key(a, b), self.paper.map(|pv| pv.face_to_face(a, b)), x, y, u);
             }
             for (f, (&x, &y)) in v.face_sum.iter().zip(&r.face_sum).enumerate() {
-                row(
-                    "face_sum",
-                    (f + 1).to_string(),
-                    self.paper.and_then(|pv| pv.face_sum(f + 1)),
-                    x,
-                    y,
-                    0.0,
-                );
+                row("face_sum", (f + 1).to_string(), self.paper.and_then(|pv| pv.face_sum(f + 1)), x, y, 0.0);
             }
             let secs = [
-                (
-                    "sphere_face",
-                    self.paper.map(|pv| pv.sphere_face_seconds),
-                    o.sphere_face_seconds(),
-                ),
-                (
-                    "face_face",
-                    self.paper.map(|pv| pv.face_face_seconds),
-                    o.face_face_seconds(),
-                ),
-                (
-                    "total",
-                    self.paper
-                        .map(|pv| pv.sphere_face_seconds + pv.face_face_seconds),
-                    o.total_seconds(),
-                ),
+                ("sphere_face", self.paper.map(|pv| pv.sphere_face_seconds), o.sphere_face_seconds()),
+                ("face_face", self.paper.map(|pv| pv.face_face_seconds), o.face_face_seconds()),
+                ("total", self.paper.map(|pv| pv.sphere_face_seconds + pv.face_face_seconds), o.total_seconds()),
             ];
             for (item, paper, ours) in secs {
                 let _ = writeln!(out, "seconds,{item},{p},{},{ours:e},,,", num(paper));
@@ -296,12 +246,7 @@ impl Report {
         let mut out = String::new();
         let precisions: Vec<&str> = self.outcomes.iter().map(|o| o.precision.name()).collect();
         let grids = if c.radius > 0.0 {
-            format!(
-                "sphere {}x{}, faces {k}x{k}",
-                c.sphere_grid.0,
-                c.sphere_grid.1,
-                k = c.face_grid
-            )
+            format!("sphere {}x{}, faces {k}x{k}", c.sphere_grid.0, c.sphere_grid.1, k = c.face_grid)
         } else {
             format!("no sphere, faces {k}x{k}", k = c.face_grid)
         };
@@ -330,17 +275,8 @@ impl Report {
             }
             let _ = write!(out, " {:>15}", "reference");
             for o in &self.outcomes {
-                let w = if o.precision.name() == "f32" && two {
-                    13
-                } else {
-                    15
-                };
-                let _ = write!(
-                    out,
-                    " {:>w$} {:>7}",
-                    format!("ours {}", o.precision.name()),
-                    "rel.err"
-                );
+                let w = if o.precision.name() == "f32" && two { 13 } else { 15 };
+                let _ = write!(out, " {:>w$} {:>7}", format!("ours {}", o.precision.name()), "rel.err");
             }
             out.push('\n');
         };
@@ -350,12 +286,7 @@ impl Report {
             (false, true) => format!("{x:>13.7e}"),
             (false, false) => format!("{x:>15.9e}"),
         };
-        let line = |out: &mut String,
-                    item: String,
-                    paper: Option<f64>,
-                    re: f64,
-                    ours: Vec<f64>,
-                    fixed: bool| {
+        let line = |out: &mut String, item: String, paper: Option<f64>, re: f64, ours: Vec<f64>, fixed: bool| {
             let p = match paper {
                 Some(p) if fixed => format!("{p:.4}"),
                 Some(p) => format!("{p:.4e}"),
@@ -366,60 +297,32 @@ impl Report {
                 let pe = paper.map_or("-".into(), |p| fmt_err(relative_error(p, re)));
                 let _ = write!(out, " {pe:>8}");
             }
-            let re_s = if fixed {
-                format!("{re:.10}")
-            } else {
-                format!("{re:.9e}")
-            };
+            let re_s = if fixed { format!("{re:.10}") } else { format!("{re:.9e}") };
             let _ = write!(out, " {re_s:>15}");
             for (o, x) in self.outcomes.iter().zip(ours) {
                 let f32_col = o.precision.name() == "f32";
-                let _ = write!(
-                    out,
-                    " {} {:>7}",
-                    fmt_ours(x, f32_col, fixed),
-                    fmt_err(relative_error(x, re))
-                );
+                let _ = write!(out, " {} {:>7}", fmt_ours(x, f32_col, fixed), fmt_err(relative_error(x, re)));
             }
             out.push('\n');
         };
 
         if let Some(rs) = r.sphere_to_face {
-            let _ = writeln!(
-                out,
-                "\nTable 1. Sphere -> face, eq. (25). Reference: exact 1/6."
-            );
+            let _ = writeln!(out, "\nTable 1. Sphere -> face, eq. (25). Reference: exact 1/6.");
             header(&mut out, "face");
             for (f, &re) in rs.iter().enumerate() {
                 let ours = self
                     .outcomes
                     .iter()
-                    .map(|o| {
-                        o.values
-                            .sphere_to_face
-                            .and_then(|s| s.get(f).copied())
-                            .unwrap_or(f64::NAN)
-                    })
+                    .map(|o| o.values.sphere_to_face.and_then(|s| s.get(f).copied()).unwrap_or(f64::NAN))
                     .collect();
-                line(
-                    &mut out,
-                    (f + 1).to_string(),
-                    self.paper.map(|p| p.sphere_to_face(f + 1)),
-                    re,
-                    ours,
-                    false,
-                );
+                line(&mut out, (f + 1).to_string(), self.paper.map(|p| p.sphere_to_face(f + 1)), re, ours, false);
             }
         }
 
         let _ = writeln!(
             out,
             "\nTable 3. Face -> face, eq. (26){}. Ref.: {}.",
-            if c.radius > 0.0 {
-                ", sphere as occluder"
-            } else {
-                ""
-            },
+            if c.radius > 0.0 { ", sphere as occluder" } else { "" },
             match r.source {
                 Source::ClosedForm => "exact, C-11 / C-14",
                 Source::Independent | Source::Stored => "independent, below",
@@ -429,37 +332,19 @@ impl Report {
         header(&mut out, "pair");
         for (k, &(a, b)) in FACE_PAIRS.iter().enumerate() {
             let re = r.face_to_face.get(k).copied().unwrap_or(f64::NAN);
-            let ours = self
-                .outcomes
-                .iter()
-                .map(|o| o.values.face_to_face.get(k).copied().unwrap_or(f64::NAN))
-                .collect();
-            line(
-                &mut out,
-                pair_key(a, b),
-                self.paper.map(|p| p.face_to_face(a, b)),
-                re,
-                ours,
-                false,
-            );
+            let ours =
+                self.outcomes.iter().map(|o| o.values.face_to_face.get(k).copied().unwrap_or(f64::NAN)).collect();
+            line(&mut out, pair_key(a, b), self.paper.map(|p| p.face_to_face(a, b)), re, ours, false);
         }
 
         if let Some(rs) = r.face_to_sphere {
-            let _ = writeln!(
-                out,
-                "\nFace -> sphere by reciprocity, A_s F_s->f / A_f. Reference: 4 pi R^2 / 216."
-            );
+            let _ = writeln!(out, "\nFace -> sphere by reciprocity, A_s F_s->f / A_f. Reference: 4 pi R^2 / 216.");
             header(&mut out, "face");
             for (f, &re) in rs.iter().enumerate() {
                 let ours = self
                     .outcomes
                     .iter()
-                    .map(|o| {
-                        o.values
-                            .face_to_sphere
-                            .and_then(|s| s.get(f).copied())
-                            .unwrap_or(f64::NAN)
-                    })
+                    .map(|o| o.values.face_to_sphere.and_then(|s| s.get(f).copied()).unwrap_or(f64::NAN))
                     .collect();
                 line(&mut out, (f + 1).to_string(), None, re, ours, false);
             }
@@ -472,19 +357,8 @@ impl Report {
         );
         header(&mut out, "face");
         for (f, &re) in r.face_sum.iter().enumerate() {
-            let ours = self
-                .outcomes
-                .iter()
-                .map(|o| o.values.face_sum.get(f).copied().unwrap_or(f64::NAN))
-                .collect();
-            line(
-                &mut out,
-                (f + 1).to_string(),
-                self.paper.and_then(|p| p.face_sum(f + 1)),
-                re,
-                ours,
-                true,
-            );
+            let ours = self.outcomes.iter().map(|o| o.values.face_sum.get(f).copied().unwrap_or(f64::NAN)).collect();
+            line(&mut out, (f + 1).to_string(), self.paper.and_then(|p| p.face_sum(f + 1)), re, ours, true);
         }
 
         let _ = writeln!(
@@ -502,32 +376,15 @@ impl Report {
         out.push('\n');
         type Getter = fn(&Outcome) -> f64;
         let parts: [(&str, Option<f64>, Getter); 3] = [
-            (
-                "sphere -> face",
-                self.paper.map(|p| p.sphere_face_seconds),
-                Outcome::sphere_face_seconds,
-            ),
-            (
-                "face -> face",
-                self.paper.map(|p| p.face_face_seconds),
-                Outcome::face_face_seconds,
-            ),
-            (
-                "total",
-                self.paper
-                    .map(|p| p.sphere_face_seconds + p.face_face_seconds),
-                Outcome::total_seconds,
-            ),
+            ("sphere -> face", self.paper.map(|p| p.sphere_face_seconds), Outcome::sphere_face_seconds),
+            ("face -> face", self.paper.map(|p| p.face_face_seconds), Outcome::face_face_seconds),
+            ("total", self.paper.map(|p| p.sphere_face_seconds + p.face_face_seconds), Outcome::total_seconds),
         ];
         for (name, paper, get) in parts {
             let p = paper.map_or("-".into(), paper_duration);
             let _ = write!(out, "{name:<16} {p:>24}");
             for o in &self.outcomes {
-                let t = if name == "sphere -> face" && c.radius == 0.0 {
-                    "-".into()
-                } else {
-                    format_seconds(get(o))
-                };
+                let t = if name == "sphere -> face" && c.radius == 0.0 { "-".into() } else { format_seconds(get(o)) };
                 let _ = write!(out, " {t:>12}");
             }
             out.push('\n');

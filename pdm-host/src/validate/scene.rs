@@ -93,21 +93,10 @@ impl<T: Real> Scene<T> {
     /// Builds the scene for sphere radius `radius` (0 = no sphere).
     pub fn new(radius: f64) -> Result<Self, PdmError> {
         let [f1, f2, f3, f4, f5, f6] = FACES;
-        let face =
-            |(o, t, s): ([f64; 3], [f64; 3], [f64; 3])| Parallelogram::new(v::<T>(o), v(t), v(s));
-        let faces = [
-            face(f1)?,
-            face(f2)?,
-            face(f3)?,
-            face(f4)?,
-            face(f5)?,
-            face(f6)?,
-        ];
+        let face = |(o, t, s): ([f64; 3], [f64; 3], [f64; 3])| Parallelogram::new(v::<T>(o), v(t), v(s));
+        let faces = [face(f1)?, face(f2)?, face(f3)?, face(f4)?, face(f5)?, face(f6)?];
         let sphere = if radius > 0.0 {
-            Some(Sphere::outer(
-                vec3(T::ZERO, T::ZERO, T::ZERO),
-                T::from_f64(radius),
-            )?)
+            Some(Sphere::outer(vec3(T::ZERO, T::ZERO, T::ZERO), T::from_f64(radius))?)
         } else {
             None
         };
@@ -124,14 +113,7 @@ mod tests {
     fn faces_point_into_the_cube_and_sit_where_documented() {
         let scene = Scene::<f64>::new(1.0).unwrap();
         // (axis, coordinate of the plane) for faces 1..6
-        let planes = [
-            (2, 3.0),
-            (1, -3.0),
-            (1, 3.0),
-            (0, -3.0),
-            (0, 3.0),
-            (2, -3.0),
-        ];
+        let planes = [(2, 3.0), (1, -3.0), (1, 3.0), (0, -3.0), (0, 3.0), (2, -3.0)];
         for (k, face) in scene.faces.iter().enumerate() {
             let n = face.area_normal();
             let centre = face.origin() + (face.edge_t() + face.edge_s()).scale(0.5);
@@ -140,11 +122,7 @@ mod tests {
             let (axis, c) = planes[k];
             let coords = [centre.x, centre.y, centre.z];
             assert_eq!(coords[axis], c, "face {}", k + 1);
-            for corner in [
-                face.origin(),
-                face.origin() + face.edge_t(),
-                face.origin() + face.edge_s(),
-            ] {
+            for corner in [face.origin(), face.origin() + face.edge_t(), face.origin() + face.edge_s()] {
                 let cc = [corner.x, corner.y, corner.z];
                 assert_eq!(cc[axis], c);
                 assert!(cc.iter().all(|x| x.abs() == 3.0));
@@ -154,17 +132,12 @@ mod tests {
 
     #[test]
     fn opposite_pairs_are_the_papers() {
-        let opposite: Vec<_> = FACE_PAIRS
-            .iter()
-            .filter(|(a, b)| is_opposite(*a, *b))
-            .collect();
+        let opposite: Vec<_> = FACE_PAIRS.iter().filter(|(a, b)| is_opposite(*a, *b)).collect();
         assert_eq!(opposite, [&(1, 6), &(2, 3), &(4, 5)]);
         // Opposite faces have antiparallel normals, adjacent ones perpendicular normals.
         let scene = Scene::<f64>::new(1.0).unwrap();
         for (a, b) in FACE_PAIRS {
-            let d = scene.faces[a - 1]
-                .area_normal()
-                .dot(scene.faces[b - 1].area_normal());
+            let d = scene.faces[a - 1].area_normal().dot(scene.faces[b - 1].area_normal());
             if is_opposite(a, b) {
                 assert_eq!(d, -36.0 * 36.0);
             } else {

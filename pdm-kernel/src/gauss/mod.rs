@@ -208,15 +208,9 @@ mod tests {
             let tol = unit_tol * (2 * n) as f64;
             let rule = GaussRule::<T>::new(n).unwrap();
             for d in 0..2 * n {
-                let got: f64 = rule
-                    .points()
-                    .map(|(x, w)| w.to_f64() * x.to_f64().powi(d as i32))
-                    .sum();
+                let got: f64 = rule.points().map(|(x, w)| w.to_f64() * x.to_f64().powi(d as i32)).sum();
                 let exact = if d % 2 == 0 { 2.0 / (d as f64 + 1.0) } else { 0.0 };
-                assert!(
-                    (got - exact).abs() <= tol,
-                    "order {n}, degree {d}: {got} vs {exact}"
-                );
+                assert!((got - exact).abs() <= tol, "order {n}, degree {d}: {got} vs {exact}");
             }
             // And the rule is not exact at degree 2n (so the test can fail): x^{2n} is off by
             // 2^{2n+1}(n!)^4/((2n+1)((2n)!)^2), which is far above rounding for small n.

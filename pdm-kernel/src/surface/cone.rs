@@ -25,10 +25,18 @@ pub struct Cone<T> {
 impl<T: Real> Cone<T> {
     /// A frustum; `Err` for non-finite input, a zero axis, a negative radius, both radii zero, or
     /// height ≤ 0.
-    pub fn new(base: Vec3<T>, axis: Vec3<T>, base_radius: T, top_radius: T, height: T, side: Side) -> Result<Self, PdmError> {
+    pub fn new(
+        base: Vec3<T>,
+        axis: Vec3<T>,
+        base_radius: T,
+        top_radius: T,
+        height: T,
+        side: Side,
+    ) -> Result<Self, PdmError> {
         check_finite(&[base.x, base.y, base.z, base_radius, top_radius, height])?;
         let frame = Frame::from_axis(axis)?;
-        if !(base_radius >= T::ZERO && top_radius >= T::ZERO && base_radius + top_radius > T::ZERO && height > T::ZERO) {
+        if !(base_radius >= T::ZERO && top_radius >= T::ZERO && base_radius + top_radius > T::ZERO && height > T::ZERO)
+        {
             return Err(PdmError::Degenerate);
         }
         Ok(Self { base, frame, base_radius, top_radius, height, side })

@@ -244,7 +244,11 @@ impl<T: Real> Frame<T> {
     /// The frame with the z axis as axis: u = x̂, w = ŷ.
     #[must_use]
     pub fn standard() -> Self {
-        Self { u: vec3(T::ONE, T::ZERO, T::ZERO), w: vec3(T::ZERO, T::ONE, T::ZERO), axis: vec3(T::ZERO, T::ZERO, T::ONE) }
+        Self {
+            u: vec3(T::ONE, T::ZERO, T::ZERO),
+            w: vec3(T::ZERO, T::ONE, T::ZERO),
+            axis: vec3(T::ZERO, T::ZERO, T::ONE),
+        }
     }
 
     /// u·a + w·b + axis·c for scalar coordinates in any arithmetic.

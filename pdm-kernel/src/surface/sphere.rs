@@ -128,7 +128,10 @@ mod tests {
         let frame = Frame::from_axis(vec3(1.0, -2.0, 0.5)).unwrap();
         for side in [Side::Outer, Side::Inner] {
             closed_form_matches_auto(&Sphere::with_frame(vec3(1.0, 2.0, 3.0), 1.5, frame, side).unwrap(), 1e-14);
-            normal_matches_finite_differences(&Sphere::with_frame(vec3(1.0, 2.0, 3.0), 1.5, frame, side).unwrap(), 1e-8);
+            normal_matches_finite_differences(
+                &Sphere::with_frame(vec3(1.0, 2.0, 3.0), 1.5, frame, side).unwrap(),
+                1e-8,
+            );
         }
     }
 

@@ -7,8 +7,8 @@
 
 use pdm_host::reference::closed_form as exact;
 use pdm_kernel::{
-    form_factor, form_factor_between, self_form_factor, surface_form_factor, Disk, Parallelogram, ParamRect, Patch,
-    PatchGrid, PatchSamples, Quadrature, Real, Sphere, vec3,
+    form_factor, form_factor_between, self_form_factor, surface_form_factor, vec3, Disk, Parallelogram, ParamRect,
+    Patch, PatchGrid, PatchSamples, Quadrature, Real, Sphere,
 };
 
 /// (case, precision, allowed relative error). The f32 allowances reflect f32 rounding of the
@@ -44,11 +44,18 @@ fn check(case: &str, precision: &str, got: f64, reference: f64) {
     let rel = (got - reference).abs() / reference.abs();
     let limit = allowed(case, precision);
     println!("{case} [{precision}]: got {got:.16e}, reference {reference:.16e}, relative error {rel:.2e} (allowed {limit:.0e})");
-    assert!(rel <= limit, "{case} [{precision}]: relative error {rel:e} > {limit:e} (got {got}, reference {reference})");
+    assert!(
+        rel <= limit,
+        "{case} [{precision}]: relative error {rel:e} > {limit:e} (got {got}, reference {reference})"
+    );
 }
 
 fn name<T: Real>() -> &'static str {
-    if T::MANTISSA_DIGITS == 24 { "f32" } else { "f64" }
+    if T::MANTISSA_DIGITS == 24 {
+        "f32"
+    } else {
+        "f64"
+    }
 }
 
 fn v<T: Real>(x: f64, y: f64, z: f64) -> pdm_kernel::Vec3<T> {
@@ -141,12 +148,12 @@ fn sphere_in_cube<T: Real>() {
     let case = "sphere in cube: sphere -> each face = 1/6, 8x16 / 4x4, order 8";
     let sphere = Sphere::outer(v::<T>(0.0, 0.0, 0.0), T::ONE).unwrap();
     let faces = [
-        (v::<T>(-3.0, -3.0, 3.0), v(0.0, 6.0, 0.0), v(6.0, 0.0, 0.0)),   // z = +3, facing −z
-        (v::<T>(-3.0, -3.0, -3.0), v(6.0, 0.0, 0.0), v(0.0, 6.0, 0.0)),  // z = −3, facing +z
-        (v::<T>(-3.0, -3.0, -3.0), v(0.0, 0.0, 6.0), v(6.0, 0.0, 0.0)),  // y = −3, facing +y
-        (v::<T>(-3.0, 3.0, -3.0), v(6.0, 0.0, 0.0), v(0.0, 0.0, 6.0)),   // y = +3, facing −y
-        (v::<T>(-3.0, -3.0, -3.0), v(0.0, 6.0, 0.0), v(0.0, 0.0, 6.0)),  // x = −3, facing +x
-        (v::<T>(3.0, -3.0, -3.0), v(0.0, 0.0, 6.0), v(0.0, 6.0, 0.0)),   // x = +3, facing −x
+        (v::<T>(-3.0, -3.0, 3.0), v(0.0, 6.0, 0.0), v(6.0, 0.0, 0.0)), // z = +3, facing −z
+        (v::<T>(-3.0, -3.0, -3.0), v(6.0, 0.0, 0.0), v(0.0, 6.0, 0.0)), // z = −3, facing +z
+        (v::<T>(-3.0, -3.0, -3.0), v(0.0, 0.0, 6.0), v(6.0, 0.0, 0.0)), // y = −3, facing +y
+        (v::<T>(-3.0, 3.0, -3.0), v(6.0, 0.0, 0.0), v(0.0, 0.0, 6.0)), // y = +3, facing −y
+        (v::<T>(-3.0, -3.0, -3.0), v(0.0, 6.0, 0.0), v(0.0, 0.0, 6.0)), // x = −3, facing +x
+        (v::<T>(3.0, -3.0, -3.0), v(0.0, 0.0, 6.0), v(0.0, 6.0, 0.0)), // x = +3, facing −x
     ];
     let mut sum = 0.0;
     for (o, et, es) in faces {
@@ -178,7 +185,9 @@ fn inside_sphere<T: Real>() {
     let case = "inside of a sphere: F_ij = A_j / 4 pi R^2, order 6";
     let r = 1.7;
     let sphere = Sphere::inner(v::<T>(0.3, -0.2, 1.0), T::from_f64(r)).unwrap();
-    let rect = |a: f64, b: f64, c: f64, d: f64| ParamRect::new(T::from_f64(a), T::from_f64(b), T::from_f64(c), T::from_f64(d)).unwrap();
+    let rect = |a: f64, b: f64, c: f64, d: f64| {
+        ParamRect::new(T::from_f64(a), T::from_f64(b), T::from_f64(c), T::from_f64(d)).unwrap()
+    };
     let pi = core::f64::consts::PI;
     let pa = Patch::new(&sphere, rect(0.2, 0.9, 0.0, 1.5)).unwrap();
     let pb = Patch::new(&sphere, rect(1.8, 2.9, 3.0, 5.0)).unwrap();
@@ -219,14 +228,24 @@ fn plain_rule_on_a_shared_edge_is_finite_and_in_unit_interval() {
             let f = if is_f32 {
                 let a = Parallelogram::new(v::<f32>(0.0, 0.0, 0.0), v(1.0, 0.0, 0.0), v(0.0, 1.0, 0.0)).unwrap();
                 let b = Parallelogram::new(v::<f32>(0.0, 0.0, 0.0), v(0.0, 0.0, 1.0), v(1.0, 0.0, 0.0)).unwrap();
-                form_factor_between::<f32, _, _, _, 1024>(&Patch::whole(&a).unwrap(), &Patch::whole(&b).unwrap(), Quadrature::uniform(order), &())
-                    .unwrap()
-                    .to_f64()
+                form_factor_between::<f32, _, _, _, 1024>(
+                    &Patch::whole(&a).unwrap(),
+                    &Patch::whole(&b).unwrap(),
+                    Quadrature::uniform(order),
+                    &(),
+                )
+                .unwrap()
+                .to_f64()
             } else {
                 let a = Parallelogram::new(v::<f64>(0.0, 0.0, 0.0), v(1.0, 0.0, 0.0), v(0.0, 1.0, 0.0)).unwrap();
                 let b = Parallelogram::new(v::<f64>(0.0, 0.0, 0.0), v(0.0, 0.0, 1.0), v(1.0, 0.0, 0.0)).unwrap();
-                form_factor_between::<f64, _, _, _, 1024>(&Patch::whole(&a).unwrap(), &Patch::whole(&b).unwrap(), Quadrature::uniform(order), &())
-                    .unwrap()
+                form_factor_between::<f64, _, _, _, 1024>(
+                    &Patch::whole(&a).unwrap(),
+                    &Patch::whole(&b).unwrap(),
+                    Quadrature::uniform(order),
+                    &(),
+                )
+                .unwrap()
             };
             assert!(f.is_finite() && (0.0..=1.0).contains(&f), "order {order}: {f}");
             if !is_f32 && order >= 2 {

@@ -3,8 +3,8 @@
 
 use pdm_host::reference::{closed_form as exact, contour};
 use pdm_kernel::{
-    adaptive_exchange, surface_form_factor, Adaptive, Parallelogram, Patch, PatchGrid, PatchSamples, Quadrature, Sphere,
-    vec3,
+    adaptive_exchange, surface_form_factor, vec3, Adaptive, Parallelogram, Patch, PatchGrid, PatchSamples, Quadrature,
+    Sphere,
 };
 
 fn square(o: [f64; 3], et: [f64; 3], es: [f64; 3]) -> Parallelogram<f64> {
@@ -15,9 +15,24 @@ fn square(o: [f64; 3], et: [f64; 3], es: [f64; 3]) -> Parallelogram<f64> {
 fn cases() -> Vec<(&'static str, Parallelogram<f64>, Parallelogram<f64>, f64)> {
     let floor = square([0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]);
     vec![
-        ("C-11 far (distance 5)", floor, square([0.0, 0.0, 5.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]), exact::parallel_rectangles(1.0, 1.0, 5.0)),
-        ("C-11 near (distance 0.2)", floor, square([0.0, 0.0, 0.2], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]), exact::parallel_rectangles(1.0, 1.0, 0.2)),
-        ("C-14 shared edge", floor, square([0.0; 3], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]), exact::perpendicular_rectangles(1.0, 1.0, 1.0)),
+        (
+            "C-11 far (distance 5)",
+            floor,
+            square([0.0, 0.0, 5.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]),
+            exact::parallel_rectangles(1.0, 1.0, 5.0),
+        ),
+        (
+            "C-11 near (distance 0.2)",
+            floor,
+            square([0.0, 0.0, 0.2], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]),
+            exact::parallel_rectangles(1.0, 1.0, 0.2),
+        ),
+        (
+            "C-14 shared edge",
+            floor,
+            square([0.0; 3], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]),
+            exact::perpendicular_rectangles(1.0, 1.0, 1.0),
+        ),
         ("perpendicular, gap 0.05", floor, square([0.0, 0.0, 0.05], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]), {
             let f = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
             let w = [[0.0, 0.0, 0.05], [0.0, 0.0, 1.05], [1.0, 0.0, 1.05], [1.0, 0.0, 0.05]];
@@ -68,7 +83,10 @@ fn fewer_evaluations_than_uniform_refinement_for_the_same_error() {
         }
     }
     let adaptive_error = (exchange - reference).abs() / reference;
-    println!("adaptive (tolerance 1e-6): relative error {adaptive_error:.2e} (estimate {:.2e}) with {evals} evaluations", estimate / reference);
+    println!(
+        "adaptive (tolerance 1e-6): relative error {adaptive_error:.2e} (estimate {:.2e}) with {evals} evaluations",
+        estimate / reference
+    );
     assert!(adaptive_error <= 1e-6, "adaptive missed its tolerance: {adaptive_error:e}");
     assert!(adaptive_error * reference <= estimate, "estimate not honest");
     let mut uniform_best = f64::INFINITY;
@@ -110,7 +128,11 @@ fn sphere_to_face_pairs_with_an_honest_estimate() {
     }
     let f = exchange / area;
     let actual = (f - 1.0 / 6.0).abs();
-    println!("sphere -> face adaptive 1e-6: F = {f:.12}, relative error {:.2e}, estimate {:.2e}, {evals} evaluations", actual * 6.0, estimate / area * 6.0);
+    println!(
+        "sphere -> face adaptive 1e-6: F = {f:.12}, relative error {:.2e}, estimate {:.2e}, {evals} evaluations",
+        actual * 6.0,
+        estimate / area * 6.0
+    );
     assert!(actual * 6.0 < 1e-6);
     // The estimate bounds the integration error; the areas by eq. (12) add ≈ 1e-15.
     assert!(actual <= estimate / area + 1e-14, "estimate not honest");

@@ -2,9 +2,9 @@
 //! on curved pairs, errors (not panics, not NaN) for bad input, and the sphere's poles.
 
 use pdm_kernel::{
-    exchange, form_factor, form_factor_between, surface_form_factor, AutoNormal, BezierPatch, Cone, Cylinder, Disk,
-    ParamRect, ParametricMap, Parallelogram, Patch, PatchGrid, PatchSamples, PdmError, Quadrature, Real, Scalar, Side,
-    Sphere, Vec3, vec3, MAX_ORDER,
+    exchange, form_factor, form_factor_between, surface_form_factor, vec3, AutoNormal, BezierPatch, Cone, Cylinder,
+    Disk, Parallelogram, ParamRect, ParametricMap, Patch, PatchGrid, PatchSamples, PdmError, Quadrature, Real, Scalar,
+    Side, Sphere, Vec3, MAX_ORDER,
 };
 
 /// A scene scaled by `k`: sphere → square with a second sphere partly shadowing, plus a curved pair.
@@ -22,7 +22,8 @@ fn scaled_scene<T: Real>(k: f64) -> Result<[T; 3], PdmError> {
     )?;
     let a = Parallelogram::new(v(0.0, 0.0, 0.0), v(1.0, 0.0, 0.0), v(0.0, 1.0, 0.0))?;
     let b = Parallelogram::new(v(0.0, 0.0, 1.0), v(0.0, 1.0, 0.0), v(1.0, 0.0, 0.0))?;
-    let f2 = form_factor_between::<T, _, _, _, 64>(&Patch::whole(&a)?, &Patch::whole(&b)?, Quadrature::uniform(8), &())?;
+    let f2 =
+        form_factor_between::<T, _, _, _, 64>(&Patch::whole(&a)?, &Patch::whole(&b)?, Quadrature::uniform(8), &())?;
     let tube = Cylinder::new(v(0.0, 0.0, 0.0), v(0.0, 0.0, 1.0), r(1.0), r(2.0), Side::Inner)?;
     let cell_a = PatchGrid::new(&tube, 4, 2)?.cell(0, 0).ok_or(PdmError::Degenerate)?;
     let cell_b = PatchGrid::new(&tube, 4, 2)?.cell(2, 1).ok_or(PdmError::Degenerate)?;
@@ -74,7 +75,8 @@ fn reciprocity_on_curved_pairs() {
     let bezier = pdm_kernel::Flipped(BezierPatch::new(net).unwrap()); // facing down at the sphere
     let blocker = Sphere::outer(vec3(1.3, 0.1, 0.2), 0.3).unwrap();
     for order in [3, 7] {
-        let s = PatchSamples::<f64, 64>::new(&PatchGrid::new(&sphere, 2, 4).unwrap().cell(0, 0).unwrap(), order).unwrap();
+        let s =
+            PatchSamples::<f64, 64>::new(&PatchGrid::new(&sphere, 2, 4).unwrap().cell(0, 0).unwrap(), order).unwrap();
         let t = PatchSamples::<f64, 64>::new(&PatchGrid::new(&tube, 4, 1).unwrap().cell(2, 0).unwrap(), order).unwrap();
         let c = PatchSamples::<f64, 64>::new(&Patch::whole(&cone).unwrap(), order).unwrap();
         let b = PatchSamples::<f64, 64>::new(&Patch::whole(&bezier).unwrap(), order).unwrap();
@@ -120,7 +122,10 @@ fn bad_input_is_an_error_never_a_panic_or_nan() {
         PatchSamples::<f64, 16>::new(&whole, 5).err(),
         Some(PdmError::CapacityExceeded { needed: 25, capacity: 16 })
     );
-    assert_eq!(Patch::new(&sq, ParamRect { t0: 0.5, t1: 0.5, s0: 0.0, s1: 1.0 }).err(), Some(PdmError::EmptyParameterRange));
+    assert_eq!(
+        Patch::new(&sq, ParamRect { t0: 0.5, t1: 0.5, s0: 0.0, s1: 1.0 }).err(),
+        Some(PdmError::EmptyParameterRange)
+    );
     assert_eq!(Patch::new(&sq, ParamRect { t0: 0.0, t1: nan, s0: 0.0, s1: 1.0 }).err(), Some(PdmError::NonFinite));
     assert_eq!(Patch::new(&sq, ParamRect { t0: 0.0, t1: 2.0, s0: 0.0, s1: 1.0 }).err(), Some(PdmError::OutsideDomain));
 

@@ -6,8 +6,8 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
 use pdm_kernel::{
-    form_factor, self_form_factor, surface_form_factor, AnyOccluder, Cylinder, Disk, Parallelogram, Patch, PatchGrid,
-    PatchSamples, Quadrature, Side, Sphere, vec3,
+    form_factor, self_form_factor, surface_form_factor, vec3, AnyOccluder, Cylinder, Disk, Parallelogram, Patch,
+    PatchGrid, PatchSamples, Quadrature, Side, Sphere,
 };
 
 struct Counting;
@@ -62,8 +62,16 @@ fn the_counter_counts() {
 fn computation<T: pdm_kernel::Real>() -> Result<(T, T, T), pdm_kernel::PdmError> {
     let f = |x: f64| T::from_f64(x);
     let sphere = Sphere::outer(vec3(f(0.0), f(0.0), f(0.0)), f(1.0))?;
-    let floor = Parallelogram::new(vec3(f(-3.0), f(-3.0), f(-3.0)), vec3(f(6.0), f(0.0), f(0.0)), vec3(f(0.0), f(6.0), f(0.0)))?;
-    let wall = Parallelogram::new(vec3(f(-3.0), f(-3.0), f(-3.0)), vec3(f(0.0), f(0.0), f(6.0)), vec3(f(6.0), f(0.0), f(0.0)))?;
+    let floor = Parallelogram::new(
+        vec3(f(-3.0), f(-3.0), f(-3.0)),
+        vec3(f(6.0), f(0.0), f(0.0)),
+        vec3(f(0.0), f(6.0), f(0.0)),
+    )?;
+    let wall = Parallelogram::new(
+        vec3(f(-3.0), f(-3.0), f(-3.0)),
+        vec3(f(0.0), f(0.0), f(6.0)),
+        vec3(f(6.0), f(0.0), f(0.0)),
+    )?;
     let post = Cylinder::new(vec3(f(2.0), f(2.0), f(-3.0)), vec3(f(0.0), f(0.0), f(1.0)), f(0.2), f(2.0), Side::Outer)?;
     let lid = Disk::new(vec3(f(2.0), f(2.0), f(-1.0)), vec3(f(0.0), f(0.0), f(1.0)), f(0.2))?;
     let occluders = [AnyOccluder::Sphere(sphere), AnyOccluder::Cylinder(post), AnyOccluder::Disk(lid)];

@@ -4,8 +4,8 @@
 
 use pdm_host::reference::{closed_form as exact, contour};
 use pdm_kernel::{
-    classify, pair_exchange, Adjacency, Cylinder, Disk, PairSettings, Parallelogram, Patch, PatchGrid, PatchSamples,
-    Real, Side, Sphere, Surface, Vec3, vec3,
+    classify, pair_exchange, vec3, Adjacency, Cylinder, Disk, PairSettings, Parallelogram, Patch, PatchGrid,
+    PatchSamples, Real, Side, Sphere, Surface, Vec3,
 };
 
 fn v<T: Real>(p: [f64; 3]) -> Vec3<T> {
@@ -53,7 +53,10 @@ fn perpendicular_unit_squares_reach_1e_12_in_f64_and_1e_6_in_f32() {
         let f = if is_f32 {
             let a = Parallelogram::new(v::<f32>([0.0; 3]), v([1.0, 0.0, 0.0]), v([0.0, 1.0, 0.0])).unwrap();
             let b = Parallelogram::new(v::<f32>([0.0; 3]), v([0.0, 0.0, 1.0]), v([1.0, 0.0, 0.0])).unwrap();
-            assert!(matches!(classify(&Patch::whole(&a).unwrap(), &Patch::whole(&b).unwrap()), Adjacency::SharedEdge { .. }));
+            assert!(matches!(
+                classify(&Patch::whole(&a).unwrap(), &Patch::whole(&b).unwrap()),
+                Adjacency::SharedEdge { .. }
+            ));
             grid_factor(PatchGrid::new(&a, 1, 1).unwrap(), PatchGrid::new(&b, 1, 1).unwrap(), settings(order, order))
         } else {
             let a = Parallelogram::new(v::<f64>([0.0; 3]), v([1.0, 0.0, 0.0]), v([0.0, 1.0, 0.0])).unwrap();
@@ -61,7 +64,10 @@ fn perpendicular_unit_squares_reach_1e_12_in_f64_and_1e_6_in_f32() {
             grid_factor(PatchGrid::new(&a, 1, 1).unwrap(), PatchGrid::new(&b, 1, 1).unwrap(), settings(order, order))
         };
         let e = rel(f, reference);
-        println!("perpendicular squares, order {order}, {}: {f:.16} relative error {e:.2e}", if is_f32 { "f32" } else { "f64" });
+        println!(
+            "perpendicular squares, order {order}, {}: {f:.16} relative error {e:.2e}",
+            if is_f32 { "f32" } else { "f64" }
+        );
         e
     };
     // Exponential convergence: each step of 2 in the order gains orders of magnitude.
@@ -151,7 +157,11 @@ fn disk_and_the_cylinder_wall_it_closes_share_a_curved_edge() {
     let base = Disk::new(v::<f64>([0.0; 3]), axis, r).unwrap();
     let wall = Cylinder::new(v::<f64>([0.0; 3]), axis, r, h, Side::Inner).unwrap();
     for (sectors, order, allowed) in [(4usize, 10usize, 1e-8), (8, 14, 1e-10)] {
-        let f = grid_factor(PatchGrid::new(&base, 2, sectors).unwrap(), PatchGrid::new(&wall, sectors, 3).unwrap(), settings(order, order));
+        let f = grid_factor(
+            PatchGrid::new(&base, 2, sectors).unwrap(),
+            PatchGrid::new(&wall, sectors, 3).unwrap(),
+            settings(order, order),
+        );
         let e = rel(f, reference);
         println!("disk -> cylinder wall, {sectors} sectors, order {order}: {f:.15} vs {reference:.15}: {e:.2e}");
         assert!(e < allowed, "{e:e}");
@@ -165,7 +175,11 @@ fn hemisphere_and_its_base_share_the_equator() {
     let sphere = Sphere::inner(v::<f64>([0.0; 3]), 1.0).unwrap();
     let base = Disk::new(v::<f64>([0.0; 3]), v([0.0, 0.0, 1.0]), 1.0).unwrap();
     let dome = pdm_kernel::ParamRect::new(0.0, core::f64::consts::FRAC_PI_2, 0.0, 2.0 * core::f64::consts::PI).unwrap();
-    let f = grid_factor(PatchGrid::new(&base, 2, 8).unwrap(), PatchGrid::over(&sphere, dome, 2, 8).unwrap(), settings(12, 12));
+    let f = grid_factor(
+        PatchGrid::new(&base, 2, 8).unwrap(),
+        PatchGrid::over(&sphere, dome, 2, 8).unwrap(),
+        settings(12, 12),
+    );
     println!("base -> dome: {f:.15}");
     assert!((f - 1.0).abs() < 1e-9, "{f}");
 }
