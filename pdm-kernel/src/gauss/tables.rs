@@ -224,14 +224,30 @@ pub(crate) fn fixed_f32<const N: usize>() -> (&'static [f32], &'static [f32]) {
         _ => (&[], &[]),
     }
 }
-static NODES_1_F64: [f64; 1] = [f64::from_bits(0x0000000000000000)];
-static WEIGHTS_1_F64: [f64; 1] = [f64::from_bits(0x4000000000000000)];
-static NODES_2_F64: [f64; 2] = [f64::from_bits(0xbfe279a74590331c), f64::from_bits(0x3fe279a74590331c)];
-static WEIGHTS_2_F64: [f64; 2] = [f64::from_bits(0x3ff0000000000000), f64::from_bits(0x3ff0000000000000)];
-static NODES_3_F64: [f64; 3] =
-    [f64::from_bits(0xbfe8c97ef43f7248), f64::from_bits(0x0000000000000000), f64::from_bits(0x3fe8c97ef43f7248)];
-static WEIGHTS_3_F64: [f64; 3] =
-    [f64::from_bits(0x3fe1c71c71c71c72), f64::from_bits(0x3fec71c71c71c71c), f64::from_bits(0x3fe1c71c71c71c72)];
+static NODES_1_F64: [f64; 1] = [
+    f64::from_bits(0x0000000000000000),
+];
+static WEIGHTS_1_F64: [f64; 1] = [
+    f64::from_bits(0x4000000000000000),
+];
+static NODES_2_F64: [f64; 2] = [
+    f64::from_bits(0xbfe279a74590331c),
+    f64::from_bits(0x3fe279a74590331c),
+];
+static WEIGHTS_2_F64: [f64; 2] = [
+    f64::from_bits(0x3ff0000000000000),
+    f64::from_bits(0x3ff0000000000000),
+];
+static NODES_3_F64: [f64; 3] = [
+    f64::from_bits(0xbfe8c97ef43f7248),
+    f64::from_bits(0x0000000000000000),
+    f64::from_bits(0x3fe8c97ef43f7248),
+];
+static WEIGHTS_3_F64: [f64; 3] = [
+    f64::from_bits(0x3fe1c71c71c71c72),
+    f64::from_bits(0x3fec71c71c71c71c),
+    f64::from_bits(0x3fe1c71c71c71c72),
+];
 static NODES_4_F64: [f64; 4] = [
     f64::from_bits(0xbfeb8e6dbcf63985),
     f64::from_bits(0xbfd5c23fd9dd3dfc),
@@ -1392,16 +1408,42 @@ static WEIGHTS_32_F64: [f64; 32] = [
     f64::from_bits(0x3f90aa3c248696c9),
     f64::from_bits(0x3f7cbf8bc743cc5c),
 ];
-static NODES_1_F32: [f32; 1] = [f32::from_bits(0x00000000)];
-static WEIGHTS_1_F32: [f32; 1] = [f32::from_bits(0x40000000)];
-static NODES_2_F32: [f32; 2] = [f32::from_bits(0xbf13cd3a), f32::from_bits(0x3f13cd3a)];
-static WEIGHTS_2_F32: [f32; 2] = [f32::from_bits(0x3f800000), f32::from_bits(0x3f800000)];
-static NODES_3_F32: [f32; 3] = [f32::from_bits(0xbf464bf8), f32::from_bits(0x00000000), f32::from_bits(0x3f464bf8)];
-static WEIGHTS_3_F32: [f32; 3] = [f32::from_bits(0x3f0e38e4), f32::from_bits(0x3f638e39), f32::from_bits(0x3f0e38e4)];
-static NODES_4_F32: [f32; 4] =
-    [f32::from_bits(0xbf5c736e), f32::from_bits(0xbeae11ff), f32::from_bits(0x3eae11ff), f32::from_bits(0x3f5c736e)];
-static WEIGHTS_4_F32: [f32; 4] =
-    [f32::from_bits(0x3eb21a08), f32::from_bits(0x3f26f2fc), f32::from_bits(0x3f26f2fc), f32::from_bits(0x3eb21a08)];
+static NODES_1_F32: [f32; 1] = [
+    f32::from_bits(0x00000000),
+];
+static WEIGHTS_1_F32: [f32; 1] = [
+    f32::from_bits(0x40000000),
+];
+static NODES_2_F32: [f32; 2] = [
+    f32::from_bits(0xbf13cd3a),
+    f32::from_bits(0x3f13cd3a),
+];
+static WEIGHTS_2_F32: [f32; 2] = [
+    f32::from_bits(0x3f800000),
+    f32::from_bits(0x3f800000),
+];
+static NODES_3_F32: [f32; 3] = [
+    f32::from_bits(0xbf464bf8),
+    f32::from_bits(0x00000000),
+    f32::from_bits(0x3f464bf8),
+];
+static WEIGHTS_3_F32: [f32; 3] = [
+    f32::from_bits(0x3f0e38e4),
+    f32::from_bits(0x3f638e39),
+    f32::from_bits(0x3f0e38e4),
+];
+static NODES_4_F32: [f32; 4] = [
+    f32::from_bits(0xbf5c736e),
+    f32::from_bits(0xbeae11ff),
+    f32::from_bits(0x3eae11ff),
+    f32::from_bits(0x3f5c736e),
+];
+static WEIGHTS_4_F32: [f32; 4] = [
+    f32::from_bits(0x3eb21a08),
+    f32::from_bits(0x3f26f2fc),
+    f32::from_bits(0x3f26f2fc),
+    f32::from_bits(0x3eb21a08),
+];
 static NODES_5_F32: [f32; 5] = [
     f32::from_bits(0xbf67fb67),
     f32::from_bits(0xbf09d920),
