@@ -32,8 +32,9 @@ pub enum PdmError {
         /// Entries available.
         capacity: usize,
     },
-    /// The computed form factor was not a finite number in [0, 1 + tolerance] (indicates input
-    /// geometry the method cannot handle, e.g. interpenetrating patches).
+    /// The computed form factor (or exchange) was not a finite, non-negative number. (A plain
+    /// rule at a low order may exceed 1 for a large, close receiver; that is a quadrature error,
+    /// not refused here.)
     InvalidResult,
 }
 

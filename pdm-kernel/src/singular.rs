@@ -133,6 +133,12 @@ fn corner_points<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>) -> [Vec3<
     [s.point(r.t0, r.s0), s.point(r.t1, r.s0), s.point(r.t0, r.s1), s.point(r.t1, r.s1)]
 }
 
+/// The parameter-space centre of a patch.
+fn centre_of<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>) -> (T, T) {
+    let r = p.rect();
+    ((r.t0 + r.t1) * T::HALF, (r.s0 + r.s1) * T::HALF)
+}
+
 /// Relative tolerance for "the same point" in adjacency detection.
 fn adjacency_tolerance<T: Real>() -> T {
     T::GEOMETRY_TOLERANCE.sqrt() * T::from_f64(0.01)
@@ -209,14 +215,19 @@ where
     let same = |p: Vec3<T>, q: Vec3<T>| (p - q).norm() <= tol;
     let gap_of = |p: Vec3<T>, q: Vec3<T>| if scale > T::ZERO { (p - q).norm() / scale } else { T::ZERO };
     // matches[i] = Some(j) if corner i of A coincides with corner j of B.
+    // One-to-one: a corner of B is matched at most once (a patch with a collapsed edge — a
+    // sphere's polar cell, a cone's apex — has two equal corners).
     let mut matches = [None; 4];
+    let mut used = [false; 4];
     let mut count = 0;
     for (i, p) in ca.iter().enumerate() {
         for (j, q) in cb.iter().enumerate() {
-            if same(*p, *q) {
-                if let Some(m) = matches.get_mut(i) {
+            let free = used.get(j).is_some_and(|u| !*u);
+            if free && same(*p, *q) {
+                if let (Some(m), Some(u)) = (matches.get_mut(i), used.get_mut(j)) {
                     if m.is_none() {
                         *m = Some(j);
+                        *u = true;
                         count += 1;
                     }
                 }
@@ -267,7 +278,18 @@ where
                 _ => (Adjacency::Separate, T::ZERO),
             }
         }
-        _ => (Adjacency::Identical, T::ZERO),
+        _ => {
+            // Three or four corners in common: the same patch only if the centres coincide too
+            // (two polar cells of a sphere share all their corners but not their centres).
+            let (ta, sa) = centre_of(a);
+            let (tb, sb) = centre_of(b);
+            if count == 4 && same(a.surface().point(ta, sa), b.surface().point(tb, sb)) {
+                (Adjacency::Identical, T::ZERO)
+            } else {
+                // Several shared edges (or an ambiguous match): no single transform applies.
+                (Adjacency::Separate, T::ZERO)
+            }
+        }
     }
 }
 
@@ -302,6 +324,9 @@ where
     O: Occluder<T> + ?Sized,
 {
     let rule = GaussRule::<T>::new(order)?;
+    // A gap at the level of rounding is no gap (and a subnormal one would make hundreds of
+    // graded intervals).
+    let gap = if gap > T::from_f64(64.0) * T::EPSILON && gap.is_finite() { gap } else { T::ZERO };
     let sum = match adjacency {
         Adjacency::SharedEdge { a: ma, b: mb } => {
             let (la, lb) = (Local { patch: a, map: ma }, Local { patch: b, map: mb });
