@@ -22,6 +22,7 @@
 //! visibility boundary (terminator or shadow edge inside a patch).
 
 use crate::error::PdmError;
+use crate::gauss::GaussRule;
 use crate::patch::{Patch, PatchGrid};
 use crate::real::Real;
 use crate::samples::PatchSamples;
@@ -112,11 +113,9 @@ where
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
-    let mut sa = PatchSamples::<T, CAP>::empty();
-    let mut sb = PatchSamples::<T, CAP>::empty();
-    sa.fill(a, quadrature.order_a, quadrature.order_a)?;
-    sb.fill(b, quadrature.order_b, quadrature.order_b)?;
-    form_factor(&sa, &sb, occluders)
+    let rule_a = GaussRule::<T>::new(quadrature.order_a)?;
+    let rule_b = GaussRule::<T>::new(quadrature.order_b)?;
+    crate::fixed::form_factor_between_with_rules::<T, SA, SB, O, CAP>(a, b, &rule_a, &rule_b, occluders)
 }
 
 /// F_{a→a}: the fraction of a concave patch's radiation that falls on the patch itself
@@ -150,9 +149,8 @@ where
 /// patches of grid `a` and grid `b`, each patch pair by eq. (16). A_A is the sum of the patch
 /// areas by eq. (12) with the same rule (so that a surface's factors to a closed enclosure sum
 /// to 1 up to the quadrature error). Every patch of `b` is re-sampled for each patch of `a`;
-/// nothing is allocated. For a surface against itself (the same grid), pass the grid twice:
-/// pairs of identical patches are then computed with [`self_form_factor`]'s interlaced orders
-/// only if `same_surface` is `true`.
+/// nothing is allocated. Every pair uses the plain sum: for a concave surface against itself,
+/// identical patches need [`self_form_factor`] (or use [`crate::pair_exchange`] per pair).
 pub fn surface_form_factor<T, SA, SB, O, const CAP: usize>(
     a: PatchGrid<'_, T, SA>,
     b: PatchGrid<'_, T, SB>,
@@ -165,23 +163,9 @@ where
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
-    let mut total_area = T::ZERO;
-    let mut total_exchange = T::ZERO;
-    let mut sa = PatchSamples::<T, CAP>::empty();
-    let mut sb = PatchSamples::<T, CAP>::empty();
-    for pa in a {
-        sa.fill(&pa, quadrature.order_a, quadrature.order_a)?;
-        total_area += sa.area();
-        for pb in b.clone() {
-            sb.fill(&pb, quadrature.order_b, quadrature.order_b)?;
-            total_exchange += exchange(&sa, &sb, occluders)?;
-        }
-    }
-    let value = total_exchange / total_area;
-    if !value.is_finite() {
-        return Err(PdmError::InvalidResult);
-    }
-    Ok(value)
+    let rule_a = GaussRule::<T>::new(quadrature.order_a)?;
+    let rule_b = GaussRule::<T>::new(quadrature.order_b)?;
+    crate::fixed::surface_form_factor_with_rules::<T, SA, SB, O, CAP>(a, b, &rule_a, &rule_b, occluders)
 }
 
 /// Σ_k w_k Σ_l w_l (n̂_k·e / L²)(−n̂_l·e / L²) over mutually facing, unoccluded pairs.
