@@ -3,4 +3,5 @@
 
 pub mod gauss_gen;
 pub mod reference;
+pub mod tradeoff;
 pub mod validate;

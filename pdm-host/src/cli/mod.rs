@@ -30,6 +30,8 @@ enum Command {
     /// Recompute the paper's section 4 test (a sphere in a cube) beside the paper's numbers
     /// and exact or independent references.
     Validate(ValidateArgs),
+    /// Accuracy against cost sweeps (CSV, SVG, Pareto fronts); curved patches vs polygons.
+    Tradeoff(pdm_host::tradeoff::TradeoffArgs),
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -160,6 +162,13 @@ pub fn main() -> ExitCode {
     };
     match cli.command {
         Command::Validate(args) => run_validate(&args),
+        Command::Tradeoff(args) => match pdm_host::tradeoff::run(&args) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(e) => {
+                eprintln!("error: {e}");
+                ExitCode::FAILURE
+            }
+        },
     }
 }
 
