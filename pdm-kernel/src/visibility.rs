@@ -47,6 +47,60 @@ pub trait Occluder<T: Real> {
         let _ = (a, b);
         true
     }
+
+    /// Closed-form visibility along a straight line: passes to `out` every parameter τ at which
+    /// `blocks(p, origin + τ·direction)` may change value (roots of the polynomials whose signs
+    /// decide it; extra candidates are harmless, a missing one is a bug) and returns `true`; or
+    /// returns `false` without a complete set, and the caller brackets and bisects instead
+    /// (the default). Used by [`crate::boundary`] on straight inner lines.
+    fn line_breaks(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut(T)) -> bool {
+        let _ = (p, origin, direction, out);
+        false
+    }
+}
+
+/// Passes the real roots of a·τ² + b·τ + c (a linear or constant polynomial included) to
+/// `out`, in a cancellation-free form; a double root is passed once, non-finite roots never.
+pub(crate) fn polynomial_roots<T: Real>(a: T, b: T, c: T, out: &mut dyn FnMut(T)) {
+    let mut emit = |x: T| {
+        if x.is_finite() {
+            out(x);
+        }
+    };
+    if a == T::ZERO {
+        if b != T::ZERO {
+            emit(-c / b);
+        }
+        return;
+    }
+    let disc = b * b - T::TWO * T::TWO * a * c;
+    if disc < T::ZERO {
+        return;
+    }
+    let q = if b >= T::ZERO { -(b + disc.sqrt()) * T::HALF } else { (disc.sqrt() - b) * T::HALF };
+    if q == T::ZERO {
+        emit(T::ZERO);
+        return;
+    }
+    emit(q / a);
+    if disc > T::ZERO {
+        emit(c / q);
+    }
+}
+
+/// (m·w)² − k·|w|² along w(τ) = w₀ + τ·d, as the coefficients (a, b, c) of a τ² + b τ + c
+/// (zero where w lies on the cone of directions from p tangent to a sphere, k = |m|² − R²).
+#[inline]
+fn cone_polynomial<T: Real>(m: Vec3<T>, k: T, w0: Vec3<T>, d: Vec3<T>) -> (T, T, T) {
+    let (md, mw) = (m.dot(d), m.dot(w0));
+    (md * md - k * d.norm2(), T::TWO * (md * mw - k * d.dot(w0)), mw * mw - k * w0.norm2())
+}
+
+/// |x(τ) − c|² − r² for x(τ) = x₀ + τ·d, as (a, b, c).
+#[inline]
+fn sphere_polynomial<T: Real>(x0: Vec3<T>, d: Vec3<T>, center: Vec3<T>, r: T) -> (T, T, T) {
+    let f = x0 - center;
+    (d.norm2(), T::TWO * f.dot(d), f.norm2() - r * r)
 }
 
 /// `true` if the ball (c, r) can meet some segment between the balls `a` and `b`: every such
@@ -103,6 +157,24 @@ impl<T: Real> Occluder<T> for Sphere<T> {
     }
     fn may_block_between(&self, a: &Ball<T>, b: &Ball<T>) -> bool {
         ball_may_cut_pair(self.center, self.radius, a, b)
+    }
+    /// With w = q − p and m = c − p the segment meets the sphere iff its direction lies in the
+    /// tangent cone ((m·w)² ≥ (|m|² − R²)|w|²), in front of p (m·w > 0), and it reaches the
+    /// sphere (q inside, or the closest approach m·w/|w|² < 1, i.e. w·(q − c) > 0); p on the
+    /// sphere switches at m·w = 0. All are polynomials of degree ≤ 2 in τ.
+    fn line_breaks(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut(T)) -> bool {
+        let m = self.center - p;
+        let w0 = origin - p;
+        let d = direction;
+        let (a, b, c) = cone_polynomial(m, m.norm2() - self.radius * self.radius, w0, d);
+        polynomial_roots(a, b, c, out);
+        polynomial_roots(T::ZERO, m.dot(d), m.dot(w0), out);
+        let (a, b, c) = sphere_polynomial(origin, d, self.center, self.radius);
+        polynomial_roots(a, b, c, out);
+        // w·(q − c) with q − c = w − m.
+        let (e0, e1) = (w0 - m, d);
+        polynomial_roots(d.dot(e1), w0.dot(e1) + d.dot(e0), w0.dot(e0), out);
+        true
     }
 }
 
@@ -175,6 +247,29 @@ impl<T: Real> Occluder<T> for Parallelogram<T> {
         let radius = (self.edge_t + self.edge_s).norm().max((self.edge_t - self.edge_s).norm()) * T::HALF;
         ball_may_cut_pair(center, radius, a, b)
     }
+    /// The crossing τ = offset / (n·w) and its coordinates (u, v) are ratios of polynomials
+    /// linear in τ: the switches are n·w = 0, q on the plane, and u, v ∈ {0, 1} (numerators
+    /// multiplied by n·w).
+    fn line_breaks(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut(T)) -> bool {
+        let n = self.normal;
+        let nn = n.norm2();
+        let (w0, d) = (origin - p, direction);
+        let offset = n.dot(self.origin - p);
+        let (nw0, nd) = (n.dot(w0), n.dot(d));
+        polynomial_roots(T::ZERO, nd, nw0, out);
+        polynomial_roots(T::ZERO, nd, nw0 - offset, out);
+        // (n·w)·(hit − o) = (p − o)(n·w) + offset·w, linear in τ: value at 0 and slope.
+        let po = p - self.origin;
+        let r0 = po.scale(nw0) + w0.scale(offset);
+        let r1 = po.scale(nd) + d.scale(offset);
+        let u = |r: Vec3<T>| r.cross(self.edge_s).dot(n);
+        let v = |r: Vec3<T>| self.edge_t.cross(r).dot(n);
+        polynomial_roots(T::ZERO, u(r1), u(r0), out);
+        polynomial_roots(T::ZERO, u(r1) - nn * nd, u(r0) - nn * nw0, out);
+        polynomial_roots(T::ZERO, v(r1), v(r0), out);
+        polynomial_roots(T::ZERO, v(r1) - nn * nd, v(r0) - nn * nw0, out);
+        true
+    }
 }
 
 impl<T: Real> Occluder<T> for Disk<T> {
@@ -199,6 +294,29 @@ impl<T: Real> Occluder<T> for Disk<T> {
     }
     fn may_block_between(&self, a: &Ball<T>, b: &Ball<T>) -> bool {
         ball_may_cut_pair(self.center, self.outer_radius, a, b)
+    }
+    /// As for the parallelogram, with the radius conditions |(n·w)(hit − c)|² = r²(n·w)²
+    /// quadratic in τ.
+    fn line_breaks(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut(T)) -> bool {
+        let n = self.frame.axis;
+        let (w0, d) = (origin - p, direction);
+        let offset = n.dot(self.center - p);
+        let (nw0, nd) = (n.dot(w0), n.dot(d));
+        polynomial_roots(T::ZERO, nd, nw0, out);
+        polynomial_roots(T::ZERO, nd, nw0 - offset, out);
+        let pc = p - self.center;
+        let r0 = pc.scale(nw0) + w0.scale(offset);
+        let r1 = pc.scale(nd) + d.scale(offset);
+        for radius in [self.inner_radius, self.outer_radius] {
+            let k = radius * radius;
+            polynomial_roots(
+                r1.norm2() - k * nd * nd,
+                T::TWO * (r0.dot(r1) - k * nw0 * nd),
+                r0.norm2() - k * nw0 * nw0,
+                out,
+            );
+        }
+        true
     }
 }
 
@@ -261,6 +379,14 @@ impl<T: Real> Occluder<T> for AnyOccluder<T> {
             Self::Cylinder(o) => o.may_block_between(a, b),
         }
     }
+    fn line_breaks(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut(T)) -> bool {
+        match self {
+            Self::Sphere(o) => o.line_breaks(p, origin, direction, out),
+            Self::Parallelogram(o) => o.line_breaks(p, origin, direction, out),
+            Self::Disk(o) => o.line_breaks(p, origin, direction, out),
+            Self::Cylinder(o) => o.line_breaks(p, origin, direction, out),
+        }
+    }
 }
 
 /// No occluder.
@@ -271,6 +397,9 @@ impl<T: Real> Occluder<T> for () {
     fn may_block_between(&self, _a: &Ball<T>, _b: &Ball<T>) -> bool {
         false
     }
+    fn line_breaks(&self, _p: Vec3<T>, _origin: Vec3<T>, _direction: Vec3<T>, _out: &mut dyn FnMut(T)) -> bool {
+        true
+    }
 }
 
 impl<T: Real, O: Occluder<T> + ?Sized> Occluder<T> for &O {
@@ -279,6 +408,9 @@ impl<T: Real, O: Occluder<T> + ?Sized> Occluder<T> for &O {
     }
     fn may_block_between(&self, a: &Ball<T>, b: &Ball<T>) -> bool {
         (**self).may_block_between(a, b)
+    }
+    fn line_breaks(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut(T)) -> bool {
+        (**self).line_breaks(p, origin, direction, out)
     }
 }
 
@@ -289,6 +421,9 @@ impl<T: Real, O: Occluder<T>> Occluder<T> for [O] {
     fn may_block_between(&self, a: &Ball<T>, b: &Ball<T>) -> bool {
         self.iter().any(|o| o.may_block_between(a, b))
     }
+    fn line_breaks(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut(T)) -> bool {
+        self.iter().all(|o| o.line_breaks(p, origin, direction, out))
+    }
 }
 
 impl<T: Real, O: Occluder<T>, const N: usize> Occluder<T> for [O; N] {
@@ -297,6 +432,9 @@ impl<T: Real, O: Occluder<T>, const N: usize> Occluder<T> for [O; N] {
     }
     fn may_block_between(&self, a: &Ball<T>, b: &Ball<T>) -> bool {
         self.as_slice().may_block_between(a, b)
+    }
+    fn line_breaks(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut(T)) -> bool {
+        self.iter().all(|o| o.line_breaks(p, origin, direction, out))
     }
 }
 
@@ -307,6 +445,9 @@ impl<T: Real, O: Occluder<T>, const N: usize> Occluder<T> for heapless::Vec<O, N
     fn may_block_between(&self, a: &Ball<T>, b: &Ball<T>) -> bool {
         self.as_slice().may_block_between(a, b)
     }
+    fn line_breaks(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut(T)) -> bool {
+        self.iter().all(|o| o.line_breaks(p, origin, direction, out))
+    }
 }
 
 impl<T: Real, O: Occluder<T>> Occluder<T> for Option<O> {
@@ -315,6 +456,9 @@ impl<T: Real, O: Occluder<T>> Occluder<T> for Option<O> {
     }
     fn may_block_between(&self, a: &Ball<T>, b: &Ball<T>) -> bool {
         self.as_ref().is_some_and(|o| o.may_block_between(a, b))
+    }
+    fn line_breaks(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut(T)) -> bool {
+        self.as_ref().is_none_or(|o| o.line_breaks(p, origin, direction, out))
     }
 }
 
@@ -325,6 +469,9 @@ impl<T: Real, A: Occluder<T>, B: Occluder<T>> Occluder<T> for (A, B) {
     fn may_block_between(&self, a: &Ball<T>, b: &Ball<T>) -> bool {
         self.0.may_block_between(a, b) || self.1.may_block_between(a, b)
     }
+    fn line_breaks(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut(T)) -> bool {
+        self.0.line_breaks(p, origin, direction, out) && self.1.line_breaks(p, origin, direction, out)
+    }
 }
 
 impl<T: Real, A: Occluder<T>, B: Occluder<T>, C: Occluder<T>> Occluder<T> for (A, B, C) {
@@ -333,6 +480,11 @@ impl<T: Real, A: Occluder<T>, B: Occluder<T>, C: Occluder<T>> Occluder<T> for (A
     }
     fn may_block_between(&self, a: &Ball<T>, b: &Ball<T>) -> bool {
         self.0.may_block_between(a, b) || self.1.may_block_between(a, b) || self.2.may_block_between(a, b)
+    }
+    fn line_breaks(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut(T)) -> bool {
+        self.0.line_breaks(p, origin, direction, out)
+            && self.1.line_breaks(p, origin, direction, out)
+            && self.2.line_breaks(p, origin, direction, out)
     }
 }
 
@@ -404,6 +556,87 @@ mod tests {
         assert!(!c.blocks(vec3(1.0, 0.0, 0.5), vec3(-1.0, 0.0, 1.5)));
         // Enters through the open top, leaves through the wall: blocked.
         assert!(c.blocks(vec3(0.0, 0.0, 2.5), vec3(3.0, 0.0, 0.5)));
+    }
+
+    /// Every change of `blocks(p, origin + τ·direction)` along a line lies at one of the
+    /// occluder's `line_breaks` candidates: sampled densely on random lines, each change is
+    /// bracketed by two samples 1e-4 apart and must contain a candidate.
+    fn check_line_breaks<O: Occluder<f64>>(occluder: &O, seed: u64) -> usize {
+        let mut state = seed;
+        let mut next = || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((state >> 11) as f64) / ((1u64 << 53) as f64) * 2.0 - 1.0
+        };
+        let mut changes = 0;
+        for _ in 0..200 {
+            let p = vec3(3.0 * next(), 3.0 * next(), 3.0 + next());
+            let origin = vec3(3.0 * next(), 3.0 * next(), -3.0 + next());
+            let direction = vec3(next(), next(), 0.3 * next()).scale(4.0);
+            let mut candidates = [0.0f64; 64];
+            let mut n = 0;
+            assert!(occluder.line_breaks(p, origin, direction, &mut |t| {
+                if let Some(c) = candidates.get_mut(n) {
+                    *c = t;
+                    n += 1;
+                }
+            }));
+            let samples = 20_000;
+            let at = |k: usize| -2.0 + 4.0 * k as f64 / samples as f64;
+            let mut prev = occluder.blocks(p, origin + direction.scale(at(0)));
+            for k in 1..=samples {
+                let now = occluder.blocks(p, origin + direction.scale(at(k)));
+                if now != prev {
+                    changes += 1;
+                    let (lo, hi) = (at(k - 1), at(k));
+                    let found = candidates.iter().take(n).any(|&c| c >= lo - 1e-9 && c <= hi + 1e-9);
+                    assert!(
+                        found,
+                        "change in [{lo}, {hi}] without a candidate (p {p:?}, line {origin:?} + t {direction:?})"
+                    );
+                }
+                prev = now;
+            }
+        }
+        changes
+    }
+
+    #[test]
+    fn line_breaks_list_every_change_of_visibility() {
+        let sphere = Sphere::new(vec3(0.2, -0.1, 0.0), 1.3, Side::Outer).unwrap();
+        let quad = Parallelogram::new(vec3(-1.0, -0.5, 0.3), vec3(2.0, 0.4, 0.1), vec3(-0.3, 1.5, 0.2)).unwrap();
+        let disk = Disk::annulus(vec3(0.1, 0.2, -0.2), vec3(0.2, 0.1, 1.0), 0.4, 1.6).unwrap();
+        // Each occluder must actually cast shadows on the sampled lines.
+        assert!(check_line_breaks(&sphere, 1) > 100);
+        assert!(check_line_breaks(&quad, 2) > 100);
+        assert!(check_line_breaks(&disk, 3) > 100);
+        let mixed = [AnyOccluder::Sphere(sphere), AnyOccluder::Parallelogram(quad), AnyOccluder::Disk(disk)];
+        assert!(check_line_breaks(&mixed, 4) > 100);
+        let tube = Cylinder::new(vec3(0.0, 0.0, -1.0), vec3(0.0, 0.0, 1.0), 1.0, 2.0, Side::Outer).unwrap();
+        assert!(!tube.line_breaks(vec3(0.0, 0.0, 3.0), vec3(0.0, 0.0, -3.0), vec3(1.0, 0.0, 0.0), &mut |_| {}));
+    }
+
+    #[test]
+    fn polynomial_roots_are_accurate_and_complete() {
+        let roots = |a: f64, b: f64, c: f64| {
+            let mut r = [f64::NAN; 2];
+            let mut n = 0;
+            polynomial_roots(a, b, c, &mut |x| {
+                if let Some(slot) = r.get_mut(n) {
+                    *slot = x;
+                }
+                n += 1;
+            });
+            (n, r)
+        };
+        // (τ − 1e8)(τ − 1e-8): the small root without cancellation.
+        let (n, r) = roots(1.0, -(1e8 + 1e-8), 1.0);
+        assert_eq!(n, 2);
+        assert!(r.iter().any(|&x| ((x - 1e-8) / 1e-8).abs() < 1e-15));
+        assert_eq!(roots(0.0, 2.0, -1.0).0, 1);
+        assert_eq!(roots(0.0, 2.0, -1.0).1[0], 0.5);
+        assert_eq!(roots(0.0, 0.0, 1.0).0, 0);
+        assert_eq!(roots(1.0, 0.0, 1.0).0, 0);
+        assert_eq!(roots(1.0, -2.0, 1.0).0, 1);
     }
 
     #[test]

@@ -385,6 +385,21 @@ fn inner_frame(fa: &FaceFrame, fb: &FaceFrame) -> FaceFrame {
     }
 }
 
+/// The blocked part of the point-to-face factor, (1/π) ∫_b cos θ_p cos θ_q / r² · [the segment
+/// p–q meets the ball] dq, for a point `p` of face `face_a` and the whole face `face_b`, by the
+/// same closed-form chords and singular points in s as [`cube_face_factors`] (Gauss order
+/// `order` on each piece). For checking a kernel's inner integral point by point; `None` for
+/// invalid input or the same face.
+#[must_use]
+pub fn blocked_point_factor(side: f64, radius: f64, face_a: usize, face_b: usize, p: V3, order: usize) -> Option<f64> {
+    let Setup::Pair(fa, fb, _) = pair_setup(side, radius, face_a, face_b)? else { return Some(0.0) };
+    let (fa, _) = outer_frame(&fa, &fb);
+    let fb = inner_frame(&fa, &fb);
+    let rule = GaussLegendre::new(order);
+    let inner = Inner { fb, na: fa.normal, h: 0.5 * side, r2: radius * radius, c: [0.0; 3], rule: &rule };
+    Some(inner.blocked_integral(p))
+}
+
 /// The blocked part `B_ab` with Gauss order `order` at every level.
 fn blocked_part(side: f64, radius: f64, fa: FaceFrame, fb: FaceFrame, order: usize) -> f64 {
     let h = 0.5 * side;
