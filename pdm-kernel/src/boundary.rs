@@ -4,19 +4,48 @@
 //! n·e changes sign inside a patch: the terminator of a sphere seen from a point, a kink) and
 //! occluder shadows (a jump) are not smooth, and a fixed rule sampling across them converges
 //! algebraically. Here the outer patch a is integrated with its Gauss points as usual; for each
-//! outer point p the inner patch b is integrated line by line (Gauss in s), and on each line the
-//! parameter values t where visibility changes are located — bracketed on a uniform grid of
-//! 2·order + 3 points and refined by bisection to machine precision — and each visible
-//! sub-interval gets its own Gauss rule. The inner integral is then exact to the rule's order
-//! for every p; what remains non-smooth is the outer integrand where a boundary touches the
-//! inner patch's edges, which finer patch grids handle.
+//! outer point p the inner patch b is integrated line by line (t-lines, Gauss in s), with the
+//! visibility changes placed into the rule at both inner levels:
 //!
-//! Cost per outer point: order lines × (2·order + 3 visibility probes + ≈ 60 bisection probes per
-//! boundary + order evaluations per visible piece). No allocation: breakpoints live in a
-//! fixed-size array (at most [`MAX_BREAKS`] per line; more is `Err(CapacityExceeded)`).
+//! * **Along a t-line**, the parameters t where visibility changes are found — in closed form
+//!   when b is a parallelogram ([`Surface::affine_map`]) and every occluder gives its
+//!   polynomials ([`Occluder::line_polynomials`]: sphere, parallelogram, disk, and their
+//!   combinations): the roots of the two facing tests (linear in t) and of the occluders'
+//!   quadratics, each piece between roots classified by the exact test at its midpoint;
+//!   otherwise bracketed on 2·order + 3 probes and bisected to machine precision. Each visible
+//!   piece gets its own Gauss rule.
+//! * **Along s**, the line integral is smooth except where the lines' visibility structure
+//!   changes: a boundary crossing a t-edge (a kink) or tangent to the t-lines (two breaks
+//!   meeting, a square-root end point). In closed form these are roots of a quadratic in s
+//!   (a polynomial's root crossing t₀ or t₁) and of a quartic (its discriminant), kept where the
+//!   structure differs on the two sides; anything else (two polynomials' roots crossing: a
+//!   polygonal shadow's corner, two shadows meeting) is bracketed on the probe grid and
+//!   bisected, continuing after each change until the next probe's structure is reached.
+//!   Each piece is integrated with the graded map s = s* + H·x² (smoothstep with both ends
+//!   singular), which turns √(s − s*) into a smooth function, and a piece next to a much
+//!   narrower neighbour (or a singular point just beyond b's edge) is cut geometrically towards
+//!   it, so that nearly coincident singular points do not slow the rule.
 //!
-//! Limitation: a visibility change narrower than the bracketing grid spacing (a shadow sliver
-//! between two probes) is not seen; its contribution is then sampled by the rule as usual.
+//! With both levels in closed form the inner integral converges exponentially for every p
+//! (measured against an independent closed-form-chord reference, `pdm-host/tests/
+//! kernel_inner_visibility.rs`: 1.9e-9, 3.6e-13, 1.2e-16 at orders 8, 12, 16; ≤ 6e-11 over 45
+//! point/face/radius cases at order 24). What remains non-smooth is the **outer** integrand
+//! J(p), on curves of face a where a shadow boundary becomes tangent to an edge of b or passes
+//! through a corner; the outer rule samples across them (algebraic convergence), which patch
+//! grids (and the 2 × 2 split in [`crate::pair`]) reduce. Placing those curves into the outer
+//! rule as well was tried (bracketing the count of inner singular points along outer t-lines
+//! converges along each line, but the outer s-level has curves parallel to the t-lines and
+//! costs 10× the time) and is not in this version.
+//!
+//! Cost per outer point: order lines × (a few polynomial roots and ≤ 16 exact visibility tests,
+//! or 2·order + 3 probes + ≈ 60 bisection probes per boundary, + order evaluations per visible
+//! piece), plus the s-level search (3 polynomial evaluations, ≤ 2 structure tests per
+//! candidate). No allocation: breakpoints live in fixed-size arrays (at most [`MAX_BREAKS`]
+//! per line; more is `Err(CapacityExceeded)`).
+//!
+//! Limitation: without closed form, a visibility change narrower than the bracketing grid
+//! spacing (a shadow sliver between two probes) is not seen; its contribution is then sampled
+//! by the rule as usual.
 
 use crate::error::PdmError;
 use crate::gauss::GaussRule;
@@ -67,9 +96,10 @@ where
     let use_occluders = occluders.may_block_between(&outer.bounds(), &inner_samples.bounds());
     let r = b.rect();
     let surface = b.surface();
-    // Closed form when b's t-lines are straight and every occluder can list its switches.
-    let closed_form = match surface.straight_t_line(r.s0) {
-        Some((o, d)) => !use_occluders || occluders.line_breaks(o + d, o, d, &mut |_| {}),
+    // Closed form when b is a parallelogram and every occluder can give its polynomials.
+    let affine = surface.affine_map();
+    let closed_form = match affine {
+        Some((o, et, _)) => !use_occluders || occluders.line_polynomials(o + et, o, et, &mut |_| {}),
         None => false,
     };
     let inner = Inner {
@@ -77,7 +107,7 @@ where
         r,
         rule: GaussRule::<T>::new(order)?,
         probes: 2 * order + 3,
-        closed_form,
+        affine: if closed_form { affine } else { None },
         use_occluders,
         occluders,
         count: &count,
@@ -96,13 +126,45 @@ where
     Ok((value, count.get()))
 }
 
+/// The nearest singular points just outside an interval, before and after it.
+type Outside<T> = (Option<T>, Option<T>);
+
+/// Most polynomials describing visibility along one line (two facing tests + the occluders').
+const MAX_POLYS: usize = 24;
+
+/// The polynomials a τ² + b τ + c of one line.
+struct Polys<T> {
+    list: [[T; 3]; MAX_POLYS],
+    n: usize,
+    overflow: bool,
+}
+
+impl<T: Real> Polys<T> {
+    fn new() -> Self {
+        Self { list: [[T::ZERO; 3]; MAX_POLYS], n: 0, overflow: false }
+    }
+    fn push(&mut self, c: [T; 3]) {
+        match self.list.get_mut(self.n) {
+            Some(slot) => {
+                *slot = c;
+                self.n += 1;
+            }
+            None => self.overflow = true,
+        }
+    }
+    fn used(&self) -> &[[T; 3]] {
+        self.list.get(..self.n).unwrap_or_default()
+    }
+}
+
 /// The inner patch b with everything needed to integrate over its visible part from one point.
 struct Inner<'x, T: Real, SB: ?Sized, O: ?Sized> {
     surface: &'x SB,
     r: ParamRect<T>,
     rule: GaussRule<T>,
     probes: usize,
-    closed_form: bool,
+    /// b's affine map when visibility is handled in closed form.
+    affine: Option<(Vec3<T>, Vec3<T>, Vec3<T>)>,
     use_occluders: bool,
     occluders: &'x O,
     count: &'x core::cell::Cell<u64>,
@@ -120,6 +182,23 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
         np.dot(e) > T::ZERO && nq.dot(e) < T::ZERO && !(self.use_occluders && self.occluders.blocks(p, q))
     }
 
+    /// The polynomials in t whose roots contain every visibility change on the t-line at s
+    /// (closed-form mode): the two facing tests (linear) and the occluders'. `false` if the
+    /// capacity is exceeded or an occluder declines.
+    fn line_polys(&self, p: Vec3<T>, np: Vec3<T>, s: T, polys: &mut Polys<T>) -> bool {
+        let Some((o, et, es)) = self.affine else { return false };
+        let origin = o + es.scale(s);
+        let w0 = origin - p;
+        let nq = self.surface.normal(self.r.t0, s);
+        polys.n = 0;
+        polys.push([T::ZERO, np.dot(et), np.dot(w0)]);
+        polys.push([T::ZERO, nq.dot(et), nq.dot(w0)]);
+        if self.use_occluders && !self.occluders.line_polynomials(p, origin, et, &mut |c| polys.push(c)) {
+            return false;
+        }
+        !polys.overflow
+    }
+
     /// The visible pieces of the t-line of b at s, seen from p.
     fn line(&self, p: Vec3<T>, np: Vec3<T>, s: T, line: &mut Line<T>) -> Result<(), PdmError> {
         let r = self.r;
@@ -127,17 +206,13 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
             let (q, nq) = self.surface.point_and_normal(t, s);
             self.visible(p, np, q, nq)
         };
-        if self.closed_form {
-            if let Some((origin, direction)) = self.surface.straight_t_line(s) {
-                let nq = self.surface.normal(r.t0, s);
-                let occ = self.use_occluders;
-                if closed_form_line(p, np, nq, origin, direction, r.t0, r.t1, occ, self.occluders, &vis_at, line) {
-                    return Ok(());
-                }
-            }
+        let mut polys = Polys::new();
+        if self.line_polys(p, np, s, &mut polys) && closed_form_line(polys.used(), r.t0, r.t1, &vis_at, line) {
+            return Ok(());
         }
         // Bracket visibility changes along the line, refine each by bisection.
         line.n = 0;
+        line.ids = 0;
         push(&mut line.breaks, &mut line.n, r.t0)?;
         locate_changes(&vis_at, r.t0, r.t1, self.probes, &mut line.breaks, &mut line.n)?;
         push(&mut line.breaks, &mut line.n, r.t1)?;
@@ -146,14 +221,137 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
         Ok(())
     }
 
-    /// The structure of a line: (number of breakpoints, visibility of the first piece); an
-    /// error counts as its own structure (it is reported again when the line is integrated).
-    fn line_signature(&self, p: Vec3<T>, np: Vec3<T>, s: T) -> (usize, bool) {
+    /// The structure of a line: (number of breakpoints, visibility of the first piece, which
+    /// polynomials make the breaks); an error counts as its own structure (it is reported
+    /// again when the line is integrated).
+    fn line_signature(&self, p: Vec3<T>, np: Vec3<T>, s: T) -> (usize, bool, u64) {
         let mut line = Line::new();
         match self.line(p, np, s, &mut line) {
-            Ok(()) => (line.n, line.first_visible),
-            Err(_) => (usize::MAX, false),
+            Ok(()) => (line.n, line.first_visible, line.ids),
+            Err(_) => (usize::MAX, false, 0),
         }
+    }
+
+    /// The singular points in s of the inner integral (closed-form mode): the lines' structure
+    /// changes where a root of a polynomial crosses a t-edge (a quadratic in s) or two roots of
+    /// one polynomial meet (its discriminant, a quartic in s); these candidates are found
+    /// exactly and kept where the structure differs on the two sides. Other changes (two
+    /// polynomials' roots crossing: a polygonal shadow's corner, two shadows meeting) are
+    /// bracketed and bisected between them. Returns the nearest singular points just outside
+    /// [s0, s1] (within a quarter of its width), towards which the end pieces are graded.
+    fn closed_form_events(
+        &self,
+        p: Vec3<T>,
+        np: Vec3<T>,
+        out: &mut [T; MAX_BREAKS + 2],
+        n: &mut usize,
+    ) -> Result<Outside<T>, PdmError> {
+        let r = self.r;
+        let h = r.s1 - r.s0;
+        // The coefficients as quadratics in x ∈ [0, 1] (s = s0 + x·h), from three lines.
+        let (mut p0, mut ph, mut p1) = (Polys::new(), Polys::new(), Polys::new());
+        let ok = self.line_polys(p, np, r.s0, &mut p0)
+            && self.line_polys(p, np, r.s0 + h * T::HALF, &mut ph)
+            && self.line_polys(p, np, r.s1, &mut p1)
+            && p0.n == ph.n
+            && ph.n == p1.n;
+        if !ok {
+            return Err(PdmError::InvalidResult);
+        }
+        let mut candidates = [T::ZERO; 4 * MAX_BREAKS];
+        let mut nc = 0usize;
+        // Candidates just outside b count too: a singular point close beyond an edge slows the
+        // rule on the piece at that edge (it is graded towards it).
+        let reach = T::HALF * T::HALF;
+        let mut add = |x: T| {
+            if x > -reach && x < T::ONE + reach {
+                if let Some(slot) = candidates.get_mut(nc) {
+                    *slot = r.s0 + h * x;
+                    nc += 1;
+                }
+            }
+        };
+        let fit = |v0: T, vh: T, v1: T| -> [T; 3] {
+            let four = T::TWO * T::TWO;
+            [v0, four * vh - T::from_f64(3.0) * v0 - v1, T::TWO * (v1 + v0) - four * vh]
+        };
+        for ((c0, ch), c1) in p0.used().iter().zip(ph.used()).zip(p1.used()) {
+            let (Some(&[a0, b0, k0]), Some(&[ah, bh, kh]), Some(&[a1, b1, k1])) = (Some(c0), Some(ch), Some(c1)) else {
+                continue;
+            };
+            let qa = fit(a0, ah, a1);
+            let qb = fit(b0, bh, b1);
+            let qc = fit(k0, kh, k1);
+            // A root crossing the t-edges: P(t_edge; x) = a(x) t² + b(x) t + c(x).
+            for t in [r.t0, r.t1] {
+                let e = |k: usize| {
+                    let g = |q: &[T; 3]| q.get(k).copied().unwrap_or(T::ZERO);
+                    g(&qa) * t * t + g(&qb) * t + g(&qc)
+                };
+                crate::visibility::polynomial_roots(e(2), e(1), e(0), &mut add);
+            }
+            // Two roots meeting: D(x) = b(x)² − 4 a(x) c(x), a quartic (roots in (−¼, 1¼)).
+            if qa.iter().any(|&c| c != T::ZERO) {
+                let bb = square(&qb);
+                let ac = product(&qa, &qc);
+                let four = T::TWO * T::TWO;
+                let d = [
+                    bb[0] - four * ac[0],
+                    bb[1] - four * ac[1],
+                    bb[2] - four * ac[2],
+                    bb[3] - four * ac[3],
+                    bb[4] - four * ac[4],
+                ];
+                roots_in_interval(&d, -reach, T::ONE + reach, &mut add);
+            }
+        }
+        let used = candidates.get_mut(..nc).unwrap_or_default();
+        sort(used);
+        // Keep the candidates where the line structure actually changes.
+        let delta = h * T::EPSILON.sqrt();
+        let mut kept = 0usize;
+        let mut last = r.s0 - h;
+        let start = *n;
+        let mut outside: Outside<T> = (None, None);
+        for &c in used.iter() {
+            if c - last <= delta {
+                continue;
+            }
+            if self.line_signature(p, np, c - delta) != self.line_signature(p, np, c + delta) {
+                last = c;
+                if c <= r.s0 + delta {
+                    outside.0 = Some(c.min(r.s0 - delta));
+                } else if c >= r.s1 - delta {
+                    if outside.1.is_none() {
+                        outside.1 = Some(c.max(r.s1 + delta));
+                    }
+                } else {
+                    push(out, n, c)?;
+                    kept += 1;
+                }
+            }
+        }
+        // Anything else between them: bracket and bisect.
+        let signature = |s: T| self.line_signature(p, np, s);
+        let mut lo = r.s0;
+        let fixed = out.get(start..*n).map_or([T::ZERO; MAX_BREAKS + 2], |f| {
+            let mut copy = [T::ZERO; MAX_BREAKS + 2];
+            for (d, s) in copy.iter_mut().zip(f) {
+                *d = *s;
+            }
+            copy
+        });
+        for k in 0..=kept {
+            let hi = if k < kept { fixed.get(k).copied().unwrap_or(r.s1) - delta } else { r.s1 };
+            let from = if k == 0 { lo } else { lo + delta };
+            if hi > from {
+                let span = (hi - from) / h;
+                let probes = 2 + (T::from_usize(self.probes) * span).to_f64() as usize;
+                locate_changes(&signature, from, hi, probes.max(3), out, n)?;
+            }
+            lo = fixed.get(k).copied().unwrap_or(r.s1);
+        }
+        Ok(outside)
     }
 
     /// J(p) = ∫_b visible (n̂_p·e)(−n_q·e)/L⁴ dq (without the 1/π).
@@ -165,10 +363,9 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
         let mut s_breaks = [T::ZERO; MAX_BREAKS + 2];
         let mut ns = 0usize;
         push(&mut s_breaks, &mut ns, r.s0)?;
-        if self.closed_form {
-            // The line structure is cheap in closed form: bracket its changes and bisect.
-            let signature = |s: T| self.line_signature(p, np, s);
-            locate_changes(&signature, r.s0, r.s1, self.probes, &mut s_breaks, &mut ns)?;
+        let mut outside = (None, None);
+        if self.affine.is_some() {
+            outside = self.closed_form_events(p, np, &mut s_breaks, &mut ns)?;
         } else {
             for t_edge in [r.t0, r.t1] {
                 let vis_edge = |s: T| {
@@ -183,20 +380,12 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
         sort(s_used);
         let mut inner = T::ZERO;
         let mut line = Line::new();
-        for w in s_used.windows(2) {
-            let (s_lo, s_hi) = match w {
-                [lo, hi] => (*lo, *hi),
-                _ => continue,
-            };
-            if !(s_hi > s_lo) {
-                continue;
-            }
-            // Where two breakpoints of the t-lines meet (a boundary tangent to the lines) the
-            // visible length grows like √(s − s*): J(s) has a square-root end point, which a
-            // Gauss rule integrates only algebraically. s = s* + H·x² (or the smoothstep
-            // 3x² − 2x³ with both ends graded) makes it smooth in x; at the other interior
-            // breaks (a boundary crossing a t-edge) the map is harmless.
-            let (grade_lo, grade_hi) = (s_lo > r.s0, s_hi < r.s1);
+        // Where two breakpoints of the t-lines meet (a boundary tangent to the lines) the
+        // visible length grows like √(s − s*): J(s) has a square-root end point, which a
+        // Gauss rule integrates only algebraically. s = s* + H·x² (or the smoothstep
+        // 3x² − 2x³ with both ends graded) makes it smooth in x; at the other interior
+        // breaks (a boundary crossing a t-edge) the map is harmless.
+        for_each_piece(s_used, r.s0, r.s1, outside, |s_lo, s_hi, grade_lo, grade_hi| {
             let width = s_hi - s_lo;
             for (xs, ws) in self.rule.points() {
                 let (u, du) = graded((xs + T::ONE) * T::HALF, grade_lo, grade_hi);
@@ -226,9 +415,93 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
                 }
                 inner += ws * T::HALF * du * width * sum;
             }
-        }
+            Ok(())
+        })?;
         Ok(inner)
     }
+}
+
+/// Calls `f(lo, hi, graded_lo, graded_hi)` for the pieces of [start, end] between the sorted
+/// singular points `breaks` (which include start and end). A piece next to a much narrower
+/// neighbour has another singular point just beyond its end, where a Gauss rule converges
+/// slowly; it is cut geometrically towards that end (widths w, 3w, 12w, … from the end, w the
+/// neighbour's width), so every sub-piece sees that point at least its own length away. Only
+/// ends at singular points are graded.
+fn for_each_piece<T: Real>(
+    breaks: &[T],
+    start: T,
+    end: T,
+    outside: Outside<T>,
+    mut f: impl FnMut(T, T, bool, bool) -> Result<(), PdmError>,
+) -> Result<(), PdmError> {
+    const MAX_LEVELS: usize = 24;
+    let n = breaks.len();
+    for k in 0..n.saturating_sub(1) {
+        let (Some(&lo), Some(&hi)) = (breaks.get(k), breaks.get(k + 1)) else { continue };
+        if !(hi > lo) {
+            continue;
+        }
+        let width = hi - lo;
+        let quarter = width * T::HALF * T::HALF;
+        let (grade_lo, grade_hi) = (lo > start, hi < end);
+        // Neighbour widths (a singular point that close beyond the end).
+        let before = if k == 0 { outside.0 } else { breaks.get(k - 1).copied() };
+        let after = if k + 2 == n { outside.1 } else { breaks.get(k + 1 + 1).copied() };
+        let left = match before {
+            Some(l) if lo - l < quarter && lo - l > T::ZERO => Some(lo - l),
+            _ => None,
+        };
+        let right = match after {
+            Some(r) if r - hi < quarter && r - hi > T::ZERO => Some(r - hi),
+            _ => None,
+        };
+        let mid = lo + width * T::HALF;
+        // From the left: [lo, lo + w], [lo + w, lo + 4w], … up to the middle.
+        let mut a = lo;
+        if let Some(w) = left {
+            let mut step = w;
+            let mut first = true;
+            for _ in 0..MAX_LEVELS {
+                let b = lo + step;
+                if !(b < mid) {
+                    break;
+                }
+                f(a, b, first && grade_lo, false)?;
+                first = false;
+                a = b;
+                step *= T::from_f64(4.0);
+            }
+        }
+        // From the right, mirrored, collected as the cut points below `hi`.
+        let mut b_end = hi;
+        let mut cuts = [T::ZERO; MAX_LEVELS];
+        let mut nc = 0usize;
+        if let Some(w) = right {
+            let mut step = w;
+            for _ in 0..MAX_LEVELS {
+                let c = hi - step;
+                if !(c > mid) || !(c > a) {
+                    break;
+                }
+                if let Some(slot) = cuts.get_mut(nc) {
+                    *slot = c;
+                    nc += 1;
+                }
+                step *= T::from_f64(4.0);
+            }
+            if let Some(&c) = nc.checked_sub(1).and_then(|j| cuts.get(j)) {
+                b_end = c;
+            }
+        }
+        f(a, b_end, grade_lo && left.is_none(), grade_hi && right.is_none())?;
+        // The right cuts, innermost first: [c_{j}, c_{j-1}], …, [c_0, hi].
+        for j in (0..nc).rev() {
+            let (Some(&c), next) = (cuts.get(j), if j == 0 { Some(&hi) } else { cuts.get(j - 1) }) else { continue };
+            let Some(&d) = next else { continue };
+            f(c, d, false, j == 0 && grade_hi)?;
+        }
+    }
+    Ok(())
 }
 
 /// The map x ↦ (u, du/dx) of [0, 1] onto itself with du/dx = 0 at the graded ends.
@@ -247,71 +520,69 @@ fn graded<T: Real>(x: T, lo: bool, hi: bool) -> (T, T) {
 }
 
 /// The visibility structure of one inner line: `breaks[..n]` ascending from the line's start to
-/// its end, pieces alternately visible and hidden starting with `first_visible`.
+/// its end, pieces alternately visible and hidden starting with `first_visible`; `ids` folds
+/// which polynomial makes each interior break (closed form; 0 otherwise).
 struct Line<T> {
     breaks: [T; MAX_BREAKS + 2],
     n: usize,
     first_visible: bool,
+    ids: u64,
 }
 
 impl<T: Real> Line<T> {
     fn new() -> Self {
-        Self { breaks: [T::ZERO; MAX_BREAKS + 2], n: 0, first_visible: false }
+        Self { breaks: [T::ZERO; MAX_BREAKS + 2], n: 0, first_visible: false, ids: 0 }
     }
 }
 
-/// Most candidate switches gathered on one straight line before falling back to bisection.
-const MAX_CANDIDATES: usize = 4 * MAX_BREAKS;
+/// Most candidate switches gathered on one line.
+const MAX_CANDIDATES: usize = 2 * MAX_POLYS;
 
-/// The visibility structure of the straight line origin + t·direction, t ∈ [t0, t1], with the
-/// constant normal `nq`, seen from p: the candidate switches are the roots of the two facing
-/// tests (linear in t) and the occluders' [`Occluder::line_breaks`]; each piece between
-/// consecutive candidates is classified by the exact test at its midpoint, and equal
-/// neighbours merged. `false` if some occluder cannot list its switches or there are too many.
-#[allow(clippy::too_many_arguments)]
-fn closed_form_line<T: Real, O: Occluder<T> + ?Sized>(
-    p: Vec3<T>,
-    np: Vec3<T>,
-    nq: Vec3<T>,
-    origin: Vec3<T>,
-    direction: Vec3<T>,
-    t0: T,
-    t1: T,
-    use_occluders: bool,
-    occluders: &O,
-    vis_at: &impl Fn(T) -> bool,
-    line: &mut Line<T>,
-) -> bool {
-    let mut candidates = [T::ZERO; MAX_CANDIDATES];
+/// The visibility structure of the line t ∈ [t0, t1] from its polynomials: the candidate
+/// switches are their real roots; each piece between consecutive candidates is classified by
+/// the exact test at its midpoint, and equal neighbours merged. `false` if there are too many.
+fn closed_form_line<T: Real>(polys: &[[T; 3]], t0: T, t1: T, vis_at: &impl Fn(T) -> bool, line: &mut Line<T>) -> bool {
+    let mut candidates = [(T::ZERO, 0u64); MAX_CANDIDATES];
     let mut n = 0usize;
     let mut overflow = false;
-    let mut add = |t: T| {
-        if t > t0 && t < t1 {
-            match candidates.get_mut(n) {
-                Some(slot) => {
-                    *slot = t;
-                    n += 1;
+    for (id, &[a, b, c]) in polys.iter().enumerate() {
+        crate::visibility::polynomial_roots(a, b, c, &mut |t| {
+            if t > t0 && t < t1 {
+                match candidates.get_mut(n) {
+                    Some(slot) => {
+                        *slot = (t, id as u64 + 1);
+                        n += 1;
+                    }
+                    None => overflow = true,
                 }
-                None => overflow = true,
             }
-        }
-    };
-    let w0 = origin - p;
-    crate::visibility::polynomial_roots(T::ZERO, np.dot(direction), np.dot(w0), &mut add);
-    crate::visibility::polynomial_roots(T::ZERO, nq.dot(direction), nq.dot(w0), &mut add);
-    if use_occluders && !occluders.line_breaks(p, origin, direction, &mut add) {
-        return false;
+        });
     }
     if overflow {
         return false;
     }
+    // Insertion sort by t.
     let used = candidates.get_mut(..n).unwrap_or_default();
-    sort(used);
+    for i in 1..used.len() {
+        let mut j = i;
+        while j > 0 {
+            let (Some(&x), Some(&y)) = (used.get(j - 1), used.get(j)) else { break };
+            if x.0 > y.0 {
+                used.swap(j - 1, j);
+                j -= 1;
+            } else {
+                break;
+            }
+        }
+    }
     line.n = 0;
+    line.ids = 0;
     let mut lo = t0;
+    let mut lo_id = 0u64;
     let mut status: Option<bool> = None;
-    for &hi in used.iter().chain(core::iter::once(&t1)) {
+    for &(hi, hi_id) in used.iter().chain(core::iter::once(&(t1, 0u64))) {
         if !(hi > lo) {
+            lo_id = hi_id;
             continue;
         }
         let v = vis_at((lo + hi) * T::HALF);
@@ -326,11 +597,13 @@ fn closed_form_line<T: Real, O: Occluder<T> + ?Sized>(
                 if push(&mut line.breaks, &mut line.n, lo).is_err() {
                     return false;
                 }
+                line.ids = line.ids.wrapping_mul(MAX_POLYS as u64 + 1).wrapping_add(lo_id);
             }
             Some(_) => {}
         }
         status = Some(v);
         lo = hi;
+        lo_id = hi_id;
     }
     if status.is_none() {
         line.first_visible = vis_at((t0 + t1) * T::HALF);
@@ -339,6 +612,94 @@ fn closed_form_line<T: Real, O: Occluder<T> + ?Sized>(
         }
     }
     push(&mut line.breaks, &mut line.n, t1).is_ok()
+}
+
+/// (q(x))² for a quadratic q, as quartic coefficients (ascending powers).
+fn square<T: Real>(q: &[T; 3]) -> [T; 5] {
+    product(q, q)
+}
+
+/// p(x)·q(x) for two quadratics, as quartic coefficients (ascending powers).
+fn product<T: Real>(p: &[T; 3], q: &[T; 3]) -> [T; 5] {
+    let mut out = [T::ZERO; 5];
+    for (i, &a) in p.iter().enumerate() {
+        for (j, &b) in q.iter().enumerate() {
+            if let Some(o) = out.get_mut(i + j) {
+                *o += a * b;
+            }
+        }
+    }
+    out
+}
+
+/// Horner evaluation of Σ c_k x^k.
+fn horner<T: Real>(c: &[T], x: T) -> T {
+    let mut v = T::ZERO;
+    for &k in c.iter().rev() {
+        v = v * x + k;
+    }
+    v
+}
+
+/// Passes the real roots in (x0, x1) of Σ c_k x^k (degree ≤ 4) where the polynomial changes
+/// sign: the roots of its derivative split (x0, x1) into monotone pieces, each bisected.
+fn roots_in_interval<T: Real>(c: &[T; 5], x0: T, x1: T, out: &mut dyn FnMut(T)) {
+    let degree = c.iter().rposition(|&k| k != T::ZERO).unwrap_or(0);
+    if degree <= 2 {
+        let g = |k: usize| c.get(k).copied().unwrap_or(T::ZERO);
+        crate::visibility::polynomial_roots(g(2), g(1), g(0), &mut |x| {
+            if x > x0 && x < x1 {
+                out(x);
+            }
+        });
+        return;
+    }
+    // Critical points: roots of the derivative (degree ≤ 3), recursively.
+    let mut derivative = [T::ZERO; 5];
+    for (k, d) in derivative.iter_mut().enumerate().take(degree) {
+        *d = c.get(k + 1).copied().unwrap_or(T::ZERO) * T::from_usize(k + 1);
+    }
+    let mut critical = [x0; 6];
+    let mut nc = 1usize;
+    roots_in_interval(&derivative, x0, x1, &mut |x| {
+        if let Some(slot) = critical.get_mut(nc) {
+            *slot = x;
+            nc += 1;
+        }
+    });
+    if let Some(slot) = critical.get_mut(nc) {
+        *slot = x1;
+        nc += 1;
+    }
+    let pts = critical.get_mut(..nc).unwrap_or_default();
+    sort(pts);
+    let coeffs = c.get(..=degree).unwrap_or_default();
+    for w in pts.windows(2) {
+        let (mut lo, mut hi) = match w {
+            [lo, hi] => (*lo, *hi),
+            _ => continue,
+        };
+        let (f_lo, f_hi) = (horner(coeffs, lo), horner(coeffs, hi));
+        if f_lo == T::ZERO && lo > x0 {
+            out(lo);
+        }
+        if !((f_lo < T::ZERO && f_hi > T::ZERO) || (f_lo > T::ZERO && f_hi < T::ZERO)) {
+            continue;
+        }
+        let rising = f_hi > T::ZERO;
+        for _ in 0..(T::MANTISSA_DIGITS + 4) {
+            let mid = (lo + hi) * T::HALF;
+            if mid <= lo || mid >= hi {
+                break;
+            }
+            if (horner(coeffs, mid) > T::ZERO) == rising {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        out((lo + hi) * T::HALF);
+    }
 }
 
 /// Appends to `out` every point of (lo, hi) where `f` changes value, found on a uniform grid of

@@ -48,12 +48,15 @@ pub trait Occluder<T: Real> {
         true
     }
 
-    /// Closed-form visibility along a straight line: passes to `out` every parameter τ at which
-    /// `blocks(p, origin + τ·direction)` may change value (roots of the polynomials whose signs
-    /// decide it; extra candidates are harmless, a missing one is a bug) and returns `true`; or
-    /// returns `false` without a complete set, and the caller brackets and bisects instead
-    /// (the default). Used by [`crate::boundary`] on straight inner lines.
-    fn line_breaks(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut(T)) -> bool {
+    /// Closed-form visibility along a straight line: passes to `out` polynomials
+    /// `[a, b, c]` (a τ² + b τ + c) such that `blocks(p, origin + τ·direction)` can change value
+    /// only at their real roots (extra polynomials are harmless, a missing one is a bug), and
+    /// returns `true`; or returns `false`, and the caller brackets and bisects instead (the
+    /// default). Contract used by [`crate::boundary`]: for fixed `p` and `direction` and
+    /// origins on a line (origin = o + s·v), every call passes the same number of polynomials
+    /// in the same order, each coefficient a polynomial of degree ≤ 2 in s (true of anything
+    /// built from dot products of origin − p taken at most twice).
+    fn line_polynomials(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut([T; 3])) -> bool {
         let _ = (p, origin, direction, out);
         false
     }
@@ -162,18 +165,18 @@ impl<T: Real> Occluder<T> for Sphere<T> {
     /// tangent cone ((m·w)² ≥ (|m|² − R²)|w|²), in front of p (m·w > 0), and it reaches the
     /// sphere (q inside, or the closest approach m·w/|w|² < 1, i.e. w·(q − c) > 0); p on the
     /// sphere switches at m·w = 0. All are polynomials of degree ≤ 2 in τ.
-    fn line_breaks(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut(T)) -> bool {
+    fn line_polynomials(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut([T; 3])) -> bool {
         let m = self.center - p;
         let w0 = origin - p;
         let d = direction;
         let (a, b, c) = cone_polynomial(m, m.norm2() - self.radius * self.radius, w0, d);
-        polynomial_roots(a, b, c, out);
-        polynomial_roots(T::ZERO, m.dot(d), m.dot(w0), out);
+        out([a, b, c]);
+        out([T::ZERO, m.dot(d), m.dot(w0)]);
         let (a, b, c) = sphere_polynomial(origin, d, self.center, self.radius);
-        polynomial_roots(a, b, c, out);
+        out([a, b, c]);
         // w·(q − c) with q − c = w − m.
         let (e0, e1) = (w0 - m, d);
-        polynomial_roots(d.dot(e1), w0.dot(e1) + d.dot(e0), w0.dot(e0), out);
+        out([d.dot(e1), w0.dot(e1) + d.dot(e0), w0.dot(e0)]);
         true
     }
 }
@@ -250,24 +253,24 @@ impl<T: Real> Occluder<T> for Parallelogram<T> {
     /// The crossing τ = offset / (n·w) and its coordinates (u, v) are ratios of polynomials
     /// linear in τ: the switches are n·w = 0, q on the plane, and u, v ∈ {0, 1} (numerators
     /// multiplied by n·w).
-    fn line_breaks(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut(T)) -> bool {
+    fn line_polynomials(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut([T; 3])) -> bool {
         let n = self.normal;
         let nn = n.norm2();
         let (w0, d) = (origin - p, direction);
         let offset = n.dot(self.origin - p);
         let (nw0, nd) = (n.dot(w0), n.dot(d));
-        polynomial_roots(T::ZERO, nd, nw0, out);
-        polynomial_roots(T::ZERO, nd, nw0 - offset, out);
+        out([T::ZERO, nd, nw0]);
+        out([T::ZERO, nd, nw0 - offset]);
         // (n·w)·(hit − o) = (p − o)(n·w) + offset·w, linear in τ: value at 0 and slope.
         let po = p - self.origin;
         let r0 = po.scale(nw0) + w0.scale(offset);
         let r1 = po.scale(nd) + d.scale(offset);
         let u = |r: Vec3<T>| r.cross(self.edge_s).dot(n);
         let v = |r: Vec3<T>| self.edge_t.cross(r).dot(n);
-        polynomial_roots(T::ZERO, u(r1), u(r0), out);
-        polynomial_roots(T::ZERO, u(r1) - nn * nd, u(r0) - nn * nw0, out);
-        polynomial_roots(T::ZERO, v(r1), v(r0), out);
-        polynomial_roots(T::ZERO, v(r1) - nn * nd, v(r0) - nn * nw0, out);
+        out([T::ZERO, u(r1), u(r0)]);
+        out([T::ZERO, u(r1) - nn * nd, u(r0) - nn * nw0]);
+        out([T::ZERO, v(r1), v(r0)]);
+        out([T::ZERO, v(r1) - nn * nd, v(r0) - nn * nw0]);
         true
     }
 }
@@ -297,24 +300,19 @@ impl<T: Real> Occluder<T> for Disk<T> {
     }
     /// As for the parallelogram, with the radius conditions |(n·w)(hit − c)|² = r²(n·w)²
     /// quadratic in τ.
-    fn line_breaks(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut(T)) -> bool {
+    fn line_polynomials(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut([T; 3])) -> bool {
         let n = self.frame.axis;
         let (w0, d) = (origin - p, direction);
         let offset = n.dot(self.center - p);
         let (nw0, nd) = (n.dot(w0), n.dot(d));
-        polynomial_roots(T::ZERO, nd, nw0, out);
-        polynomial_roots(T::ZERO, nd, nw0 - offset, out);
+        out([T::ZERO, nd, nw0]);
+        out([T::ZERO, nd, nw0 - offset]);
         let pc = p - self.center;
         let r0 = pc.scale(nw0) + w0.scale(offset);
         let r1 = pc.scale(nd) + d.scale(offset);
         for radius in [self.inner_radius, self.outer_radius] {
             let k = radius * radius;
-            polynomial_roots(
-                r1.norm2() - k * nd * nd,
-                T::TWO * (r0.dot(r1) - k * nw0 * nd),
-                r0.norm2() - k * nw0 * nw0,
-                out,
-            );
+            out([r1.norm2() - k * nd * nd, T::TWO * (r0.dot(r1) - k * nw0 * nd), r0.norm2() - k * nw0 * nw0]);
         }
         true
     }
@@ -379,12 +377,12 @@ impl<T: Real> Occluder<T> for AnyOccluder<T> {
             Self::Cylinder(o) => o.may_block_between(a, b),
         }
     }
-    fn line_breaks(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut(T)) -> bool {
+    fn line_polynomials(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut([T; 3])) -> bool {
         match self {
-            Self::Sphere(o) => o.line_breaks(p, origin, direction, out),
-            Self::Parallelogram(o) => o.line_breaks(p, origin, direction, out),
-            Self::Disk(o) => o.line_breaks(p, origin, direction, out),
-            Self::Cylinder(o) => o.line_breaks(p, origin, direction, out),
+            Self::Sphere(o) => o.line_polynomials(p, origin, direction, out),
+            Self::Parallelogram(o) => o.line_polynomials(p, origin, direction, out),
+            Self::Disk(o) => o.line_polynomials(p, origin, direction, out),
+            Self::Cylinder(o) => o.line_polynomials(p, origin, direction, out),
         }
     }
 }
@@ -397,7 +395,13 @@ impl<T: Real> Occluder<T> for () {
     fn may_block_between(&self, _a: &Ball<T>, _b: &Ball<T>) -> bool {
         false
     }
-    fn line_breaks(&self, _p: Vec3<T>, _origin: Vec3<T>, _direction: Vec3<T>, _out: &mut dyn FnMut(T)) -> bool {
+    fn line_polynomials(
+        &self,
+        _p: Vec3<T>,
+        _origin: Vec3<T>,
+        _direction: Vec3<T>,
+        _out: &mut dyn FnMut([T; 3]),
+    ) -> bool {
         true
     }
 }
@@ -409,8 +413,8 @@ impl<T: Real, O: Occluder<T> + ?Sized> Occluder<T> for &O {
     fn may_block_between(&self, a: &Ball<T>, b: &Ball<T>) -> bool {
         (**self).may_block_between(a, b)
     }
-    fn line_breaks(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut(T)) -> bool {
-        (**self).line_breaks(p, origin, direction, out)
+    fn line_polynomials(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut([T; 3])) -> bool {
+        (**self).line_polynomials(p, origin, direction, out)
     }
 }
 
@@ -421,8 +425,8 @@ impl<T: Real, O: Occluder<T>> Occluder<T> for [O] {
     fn may_block_between(&self, a: &Ball<T>, b: &Ball<T>) -> bool {
         self.iter().any(|o| o.may_block_between(a, b))
     }
-    fn line_breaks(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut(T)) -> bool {
-        self.iter().all(|o| o.line_breaks(p, origin, direction, out))
+    fn line_polynomials(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut([T; 3])) -> bool {
+        self.iter().all(|o| o.line_polynomials(p, origin, direction, out))
     }
 }
 
@@ -433,8 +437,8 @@ impl<T: Real, O: Occluder<T>, const N: usize> Occluder<T> for [O; N] {
     fn may_block_between(&self, a: &Ball<T>, b: &Ball<T>) -> bool {
         self.as_slice().may_block_between(a, b)
     }
-    fn line_breaks(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut(T)) -> bool {
-        self.iter().all(|o| o.line_breaks(p, origin, direction, out))
+    fn line_polynomials(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut([T; 3])) -> bool {
+        self.iter().all(|o| o.line_polynomials(p, origin, direction, out))
     }
 }
 
@@ -445,8 +449,8 @@ impl<T: Real, O: Occluder<T>, const N: usize> Occluder<T> for heapless::Vec<O, N
     fn may_block_between(&self, a: &Ball<T>, b: &Ball<T>) -> bool {
         self.as_slice().may_block_between(a, b)
     }
-    fn line_breaks(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut(T)) -> bool {
-        self.iter().all(|o| o.line_breaks(p, origin, direction, out))
+    fn line_polynomials(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut([T; 3])) -> bool {
+        self.iter().all(|o| o.line_polynomials(p, origin, direction, out))
     }
 }
 
@@ -457,8 +461,8 @@ impl<T: Real, O: Occluder<T>> Occluder<T> for Option<O> {
     fn may_block_between(&self, a: &Ball<T>, b: &Ball<T>) -> bool {
         self.as_ref().is_some_and(|o| o.may_block_between(a, b))
     }
-    fn line_breaks(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut(T)) -> bool {
-        self.as_ref().is_none_or(|o| o.line_breaks(p, origin, direction, out))
+    fn line_polynomials(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut([T; 3])) -> bool {
+        self.as_ref().is_none_or(|o| o.line_polynomials(p, origin, direction, out))
     }
 }
 
@@ -469,8 +473,8 @@ impl<T: Real, A: Occluder<T>, B: Occluder<T>> Occluder<T> for (A, B) {
     fn may_block_between(&self, a: &Ball<T>, b: &Ball<T>) -> bool {
         self.0.may_block_between(a, b) || self.1.may_block_between(a, b)
     }
-    fn line_breaks(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut(T)) -> bool {
-        self.0.line_breaks(p, origin, direction, out) && self.1.line_breaks(p, origin, direction, out)
+    fn line_polynomials(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut([T; 3])) -> bool {
+        self.0.line_polynomials(p, origin, direction, out) && self.1.line_polynomials(p, origin, direction, out)
     }
 }
 
@@ -481,10 +485,10 @@ impl<T: Real, A: Occluder<T>, B: Occluder<T>, C: Occluder<T>> Occluder<T> for (A
     fn may_block_between(&self, a: &Ball<T>, b: &Ball<T>) -> bool {
         self.0.may_block_between(a, b) || self.1.may_block_between(a, b) || self.2.may_block_between(a, b)
     }
-    fn line_breaks(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut(T)) -> bool {
-        self.0.line_breaks(p, origin, direction, out)
-            && self.1.line_breaks(p, origin, direction, out)
-            && self.2.line_breaks(p, origin, direction, out)
+    fn line_polynomials(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut([T; 3])) -> bool {
+        self.0.line_polynomials(p, origin, direction, out)
+            && self.1.line_polynomials(p, origin, direction, out)
+            && self.2.line_polynomials(p, origin, direction, out)
     }
 }
 
@@ -558,8 +562,8 @@ mod tests {
         assert!(c.blocks(vec3(0.0, 0.0, 2.5), vec3(3.0, 0.0, 0.5)));
     }
 
-    /// Every change of `blocks(p, origin + τ·direction)` along a line lies at one of the
-    /// occluder's `line_breaks` candidates: sampled densely on random lines, each change is
+    /// Every change of `blocks(p, origin + τ·direction)` along a line lies at a root of one of
+    /// the occluder's `line_polynomials`: sampled densely on random lines, each change is
     /// bracketed by two samples 1e-4 apart and must contain a candidate.
     fn check_line_breaks<O: Occluder<f64>>(occluder: &O, seed: u64) -> usize {
         let mut state = seed;
@@ -574,11 +578,13 @@ mod tests {
             let direction = vec3(next(), next(), 0.3 * next()).scale(4.0);
             let mut candidates = [0.0f64; 64];
             let mut n = 0;
-            assert!(occluder.line_breaks(p, origin, direction, &mut |t| {
-                if let Some(c) = candidates.get_mut(n) {
-                    *c = t;
-                    n += 1;
-                }
+            assert!(occluder.line_polynomials(p, origin, direction, &mut |[a, b, c]| {
+                polynomial_roots(a, b, c, &mut |t| {
+                    if let Some(slot) = candidates.get_mut(n) {
+                        *slot = t;
+                        n += 1;
+                    }
+                });
             }));
             let samples = 20_000;
             let at = |k: usize| -2.0 + 4.0 * k as f64 / samples as f64;
@@ -601,7 +607,7 @@ mod tests {
     }
 
     #[test]
-    fn line_breaks_list_every_change_of_visibility() {
+    fn line_polynomials_vanish_at_every_change_of_visibility() {
         let sphere = Sphere::new(vec3(0.2, -0.1, 0.0), 1.3, Side::Outer).unwrap();
         let quad = Parallelogram::new(vec3(-1.0, -0.5, 0.3), vec3(2.0, 0.4, 0.1), vec3(-0.3, 1.5, 0.2)).unwrap();
         let disk = Disk::annulus(vec3(0.1, 0.2, -0.2), vec3(0.2, 0.1, 1.0), 0.4, 1.6).unwrap();
@@ -612,7 +618,7 @@ mod tests {
         let mixed = [AnyOccluder::Sphere(sphere), AnyOccluder::Parallelogram(quad), AnyOccluder::Disk(disk)];
         assert!(check_line_breaks(&mixed, 4) > 100);
         let tube = Cylinder::new(vec3(0.0, 0.0, -1.0), vec3(0.0, 0.0, 1.0), 1.0, 2.0, Side::Outer).unwrap();
-        assert!(!tube.line_breaks(vec3(0.0, 0.0, 3.0), vec3(0.0, 0.0, -3.0), vec3(1.0, 0.0, 0.0), &mut |_| {}));
+        assert!(!tube.line_polynomials(vec3(0.0, 0.0, 3.0), vec3(0.0, 0.0, -3.0), vec3(1.0, 0.0, 0.0), &mut |_| {}));
     }
 
     #[test]

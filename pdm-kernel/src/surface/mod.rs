@@ -112,13 +112,12 @@ pub trait Surface<T: Real> {
     fn point_and_normal(&self, t: T, s: T) -> (Vec3<T>, Vec3<T>) {
         (self.point(t, s), self.normal(t, s))
     }
-    /// `Some((origin, direction))` if the t-line at `s` is straight with a constant normal:
-    /// g(t, s) = origin + t·direction and n(t, s) = n(t₀, s) for every t of the domain. The
-    /// visibility boundaries along such a line are then roots of low-degree polynomials
-    /// ([`crate::boundary`] solves them in closed form instead of bisecting). Default: `None`.
+    /// `Some((origin, edge_t, edge_s))` if the map is affine, g(t, s) = origin + t·edge_t +
+    /// s·edge_s, with the constant normal ±edge_t × edge_s (a parallelogram). Visibility
+    /// boundaries on such a patch are roots of low-degree polynomials, which
+    /// [`crate::boundary`] solves in closed form instead of bisecting. Default: `None`.
     #[inline]
-    fn straight_t_line(&self, s: T) -> Option<(Vec3<T>, Vec3<T>)> {
-        let _ = s;
+    fn affine_map(&self) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {
         None
     }
 }
@@ -136,8 +135,8 @@ impl<T: Real, S: Surface<T> + ?Sized> Surface<T> for &S {
     fn point_and_normal(&self, t: T, s: T) -> (Vec3<T>, Vec3<T>) {
         (**self).point_and_normal(t, s)
     }
-    fn straight_t_line(&self, s: T) -> Option<(Vec3<T>, Vec3<T>)> {
-        (**self).straight_t_line(s)
+    fn affine_map(&self) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {
+        (**self).affine_map()
     }
 }
 
@@ -209,8 +208,8 @@ impl<T: Real, S: Surface<T>> Surface<T> for Flipped<S> {
         let (p, n) = self.0.point_and_normal(t, s);
         (p, -n)
     }
-    fn straight_t_line(&self, s: T) -> Option<(Vec3<T>, Vec3<T>)> {
-        self.0.straight_t_line(s)
+    fn affine_map(&self) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {
+        self.0.affine_map()
     }
 }
 

@@ -91,10 +91,9 @@ impl<T: Real> Surface<T> for Parallelogram<T> {
     fn normal(&self, _t: T, _s: T) -> Vec3<T> {
         self.normal
     }
-    /// Every t-line is straight: origin + s·edge_s + t·edge_t.
     #[inline]
-    fn straight_t_line(&self, s: T) -> Option<(Vec3<T>, Vec3<T>)> {
-        Some((self.origin + self.edge_s.scale(s), self.edge_t))
+    fn affine_map(&self) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {
+        Some((self.origin, self.edge_t, self.edge_s))
     }
 }
 
