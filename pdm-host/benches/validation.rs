@@ -19,7 +19,7 @@ use pdm_host::validate::{run, Mode, NoProgress, RunConfig};
 use pdm_kernel::Real;
 
 fn config(mode: Mode, sphere_grid: (usize, usize), face_grid: usize, order: usize, singular_order: usize) -> RunConfig {
-    RunConfig { mode, sphere_grid, face_grid, order, singular_order, radius: 1.0 }
+    RunConfig { mode, sphere_grid, face_grid, order, singular_order, radius: 1.0, tolerance: None }
 }
 
 fn once<T: Real>(cfg: &RunConfig) -> f64 {

@@ -108,6 +108,23 @@ fn empty_cube_accurate_matches_c11_c14() {
     assert_eq!(j["sphere_radius"], 0.0);
 }
 
+/// `--tolerance` selects the adaptive per-pair mode; on the empty cube (only touching and
+/// smooth pairs, where the estimates are by order doubling) every factor meets it.
+#[test]
+fn tolerance_mode_meets_its_tolerance_on_the_empty_cube() {
+    for tol in [1e-5, 1e-9] {
+        let t = format!("{tol:e}");
+        let j = validate_json(&["--sphere-radius", "0", "--tolerance", &t, "--face-grid", "2"]);
+        assert_eq!(j["mode"], "accurate");
+        assert_eq!(j["tolerance"], tol);
+        let ff = pair_numbers(&j["face_to_face"]);
+        for (pair, ours) in PAIRS.iter().zip(&ff) {
+            let exact = if is_opposite(pair) { C11 } else { C14 };
+            assert!((ours - exact).abs() <= tol * exact, "{pair} at {t}: {ours} vs {exact}");
+        }
+    }
+}
+
 #[test]
 fn both_precisions_nest_f32() {
     let j = validate_json(&["--sphere-radius", "0", "--face-grid", "2", "--precision", "both", "--repeat", "1"]);
@@ -166,6 +183,10 @@ fn bad_input_is_one_line_naming_the_value() {
         (&["--format", "xml"], "xml"),
         (&["--mode", "fast"], "fast"),
         (&["--repeat", "0"], "0"),
+        (&["--tolerance", "0"], "0"),
+        (&["--tolerance", "1e-20"], "1e-20"),
+        (&["--tolerance", "nan"], "nan"),
+        (&["--mode", "paper", "--tolerance", "1e-6"], "tolerance"),
         (&["--bogus"], "--bogus"),
         (&["--patches", "86", "--face-grid", "4"], "--face-grid"),
     ];

@@ -67,9 +67,13 @@ enum Format {
 #[command(after_help = "Faces: 1: z=+3, 6: z=-3 (the sphere's poles face these), 2: y=-3, 3: y=+3, \
 4: x=-3, 5: x=+3. Cube side 6 centred at the origin, sphere of radius R at the centre.")]
 struct ValidateArgs {
-    /// Method.
-    #[arg(long, value_enum, default_value_t = ModeArg::Paper)]
-    mode: ModeArg,
+    /// Method [default: paper; accurate with --tolerance].
+    #[arg(long, value_enum)]
+    mode: Option<ModeArg>,
+    /// Accurate mode with a per-pair relative tolerance: order and subdivision chosen per
+    /// patch pair by pdm_kernel::adaptive_exchange (e.g. 1e-8) instead of fixed orders.
+    #[arg(long, value_name = "TOL", value_parser = parse_tolerance)]
+    tolerance: Option<f64>,
     /// The paper's discretisations: 86 (sphere 4x8 + 3x3 per face) or 280 (sphere 8x8 + 6x6 per face).
     #[arg(long, value_name = "86|280", value_parser = parse_patches, conflicts_with_all = ["sphere_grid", "face_grid"])]
     patches: Option<usize>,
@@ -111,6 +115,15 @@ fn parse_count(s: &str, lo: usize, hi: usize, what: &str) -> Result<usize, Strin
         Ok(n) if n >= lo as i128 && n <= hi as i128 => Ok(n as usize),
         Ok(_) => Err(format!("{what} must be an integer in {lo}..={hi}")),
         Err(_) => Err(format!("not an integer ({what} must be in {lo}..={hi})")),
+    }
+}
+
+fn parse_tolerance(s: &str) -> Result<f64, String> {
+    let (lo, hi) = (validate::MIN_TOLERANCE, validate::MAX_TOLERANCE);
+    match s.trim().parse::<f64>() {
+        Ok(t) if t.is_finite() && (lo..=hi).contains(&t) => Ok(t),
+        Ok(_) => Err(format!("the tolerance must be in {lo:e}..={hi:e}")),
+        Err(_) => Err(format!("not a number (the tolerance must be in {lo:e}..={hi:e})")),
     }
 }
 
@@ -203,9 +216,9 @@ fn one_line(text: &str) -> String {
 }
 
 fn run_validate(args: &ValidateArgs) -> ExitCode {
-    let mode = match args.mode {
-        ModeArg::Paper => Mode::Paper,
-        ModeArg::Accurate => Mode::Accurate,
+    let mode = match (args.mode, args.tolerance) {
+        (Some(ModeArg::Paper), _) | (None, None) => Mode::Paper,
+        (Some(ModeArg::Accurate), _) | (None, Some(_)) => Mode::Accurate,
     };
     let (sphere_grid, face_grid) = match args.patches {
         Some(280) => ((8, 8), 6),
@@ -222,6 +235,7 @@ fn run_validate(args: &ValidateArgs) -> ExitCode {
         order,
         singular_order: args.singular_order,
         radius: args.sphere_radius,
+        tolerance: args.tolerance,
     };
     if let Err(e) = config.check() {
         eprintln!("error: {e}");

@@ -421,6 +421,7 @@ mod tests {
             order: 5,
             singular_order: 8,
             radius: 1.0,
+            tolerance: None,
         };
         let out = run::<f64>(&cfg, 1, &NoProgress).unwrap();
         let grid = Grid::Scene { m: 4, n: 8, k: 3 };

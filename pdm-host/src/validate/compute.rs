@@ -6,7 +6,8 @@
 use std::time::Instant;
 
 use pdm_kernel::{
-    form_factor, pair_exchange, PairSettings, Parallelogram, Patch, PatchGrid, PatchSamples, PdmError, Real, Sphere,
+    adaptive_exchange, form_factor, pair_exchange, Adaptive, Occluder, PairSettings, Parallelogram, Patch, PatchGrid,
+    PatchSamples, PdmError, Real, Sphere, Surface,
 };
 use rayon::prelude::*;
 
@@ -246,6 +247,32 @@ fn paper_face_face<T: Real, const CAP: usize>(
     Ok((chunk_sums(&partial, per_pair), face_area))
 }
 
+/// Largest Gauss order the tolerance mode uses before subdividing a pair.
+pub const ADAPTIVE_MAX_ORDER: usize = 12;
+
+/// A_a·F_{a→b} for one patch pair in accurate mode: [`pair_exchange`] at the configured orders,
+/// or [`adaptive_exchange`] to the configured tolerance.
+fn accurate_pair<T, SA, SB, O, const CAP: usize>(
+    cfg: &RunConfig,
+    a: &Patch<'_, T, SA>,
+    b: &Patch<'_, T, SB>,
+    occluders: &O,
+) -> Result<T, PdmError>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
+    match cfg.tolerance {
+        Some(tol) => {
+            let settings = Adaptive { tolerance: T::from_f64(tol), max_order: ADAPTIVE_MAX_ORDER, max_depth: 6 };
+            adaptive_exchange::<T, SA, SB, O, CAP>(a, b, settings, occluders).map(|e| e.value)
+        }
+        None => pair_exchange::<T, SA, SB, O, CAP>(a, b, settings(cfg), occluders),
+    }
+}
+
 fn settings(cfg: &RunConfig) -> PairSettings {
     PairSettings { order: cfg.order, singular_order: cfg.singular_order, boundaries: true }
 }
@@ -271,7 +298,6 @@ fn accurate_sphere_face<T: Real, const CAP: usize>(
     face_patches: &[Vec<Patch<'_, T, Face<T>>>],
     progress: &dyn Progress,
 ) -> Result<SpherePart<T>, ValidateError> {
-    let set = settings(cfg);
     type Task<'a, 'p, T> = (&'a Patch<'p, T, Sphere<T>>, &'a [Patch<'p, T, Face<T>>]);
     let tasks: Vec<Task<'_, '_, T>> =
         face_patches.iter().flat_map(|face| sphere_patches.iter().map(move |s| (s, face.as_slice()))).collect();
@@ -281,7 +307,7 @@ fn accurate_sphere_face<T: Real, const CAP: usize>(
             let mut acc = T::ZERO;
             for pf in face {
                 acc +=
-                    pair_exchange::<T, _, _, _, CAP>(ps, pf, set, &()).map_err(kernel("sphere patch -> face patch"))?;
+                    accurate_pair::<T, _, _, _, CAP>(cfg, ps, pf, &()).map_err(kernel("sphere patch -> face patch"))?;
             }
             progress.advance(1);
             Ok(acc)
@@ -306,7 +332,6 @@ fn accurate_face_face<T: Real, const CAP: usize>(
     face_patches: &[Vec<Patch<'_, T, Face<T>>>],
     progress: &dyn Progress,
 ) -> Result<([T; 15], [T; 6]), ValidateError> {
-    let set = settings(cfg);
     let per_pair = cfg.face_grid * cfg.face_grid;
     type Task<'a, 'p, T> = (&'a Patch<'p, T, Face<T>>, &'a [Patch<'p, T, Face<T>>]);
     let mut tasks: Vec<Task<'_, '_, T>> = Vec::new();
@@ -320,7 +345,7 @@ fn accurate_face_face<T: Real, const CAP: usize>(
         .map(|&(pa, face_b)| {
             let mut acc = T::ZERO;
             for pb in face_b {
-                acc += pair_exchange::<T, _, _, _, CAP>(pa, pb, set, sphere)
+                acc += accurate_pair::<T, _, _, _, CAP>(cfg, pa, pb, sphere)
                     .map_err(kernel("face patch -> face patch"))?;
             }
             progress.advance(1);

@@ -91,6 +91,10 @@ pub struct RunConfig {
     pub singular_order: usize,
     /// Sphere radius (0 = no sphere).
     pub radius: f64,
+    /// Accurate mode only: `Some(tol)` computes every patch pair with
+    /// [`pdm_kernel::adaptive_exchange`] to relative tolerance `tol` (order and subdivision
+    /// chosen per pair) instead of the fixed orders.
+    pub tolerance: Option<f64>,
 }
 
 impl RunConfig {
@@ -111,6 +115,18 @@ impl RunConfig {
         for (what, o) in [("order", self.order), ("singular order", self.singular_order)] {
             if !(1..=MAX_ORDER).contains(&o) {
                 return bad(what, o.to_string(), &format!("Gauss order must be in 1..={MAX_ORDER}"));
+            }
+        }
+        if let Some(tol) = self.tolerance {
+            if !(tol.is_finite() && (MIN_TOLERANCE..=MAX_TOLERANCE).contains(&tol)) {
+                return bad(
+                    "tolerance",
+                    format!("{tol:e}"),
+                    &format!("must be in {MIN_TOLERANCE:e}..={MAX_TOLERANCE:e}"),
+                );
+            }
+            if self.mode != Mode::Accurate {
+                return bad("tolerance", format!("{tol:e}"), "applies to --mode accurate only");
             }
         }
         Ok(())
@@ -246,10 +262,17 @@ pub fn run<T: Real>(cfg: &RunConfig, repeat: usize, progress: &dyn Progress) -> 
     }
 }
 
-/// Picks the sample capacity for the order (CAP ≥ order²).
+/// Smallest `--tolerance` (below it the f64 rounding of the sums dominates).
+pub const MIN_TOLERANCE: f64 = 1e-13;
+/// Largest `--tolerance`.
+pub const MAX_TOLERANCE: f64 = 0.1;
+
+/// Picks the sample capacity for the order (CAP ≥ order²; the tolerance mode's orders go to
+/// 14).
 fn run_dispatch<T: Real>(cfg: &RunConfig, progress: &dyn Progress) -> Result<(Values, Times), ValidateError> {
     use compute::run_once;
-    match cfg.order * cfg.order {
+    let order = if cfg.tolerance.is_some() { cfg.order.max(compute::ADAPTIVE_MAX_ORDER + 2) } else { cfg.order };
+    match order * order {
         0..=25 => run_once::<T, 25>(cfg, progress),
         26..=64 => run_once::<T, 64>(cfg, progress),
         65..=144 => run_once::<T, 144>(cfg, progress),
@@ -265,7 +288,7 @@ mod tests {
     use super::*;
 
     fn cfg(mode: Mode, sphere_grid: (usize, usize), k: usize, order: usize, radius: f64) -> RunConfig {
-        RunConfig { mode, sphere_grid, face_grid: k, order, singular_order: 8, radius }
+        RunConfig { mode, sphere_grid, face_grid: k, order, singular_order: 8, radius, tolerance: None }
     }
 
     #[test]

@@ -63,6 +63,7 @@ impl Report {
         m.insert("face_grid".into(), json!(c.face_grid));
         m.insert("order".into(), json!(c.order));
         m.insert("singular_order".into(), if c.mode == Mode::Accurate { json!(c.singular_order) } else { Value::Null });
+        m.insert("tolerance".into(), c.tolerance.map_or(Value::Null, |t| json!(t)));
         m.insert("sphere_radius".into(), json!(c.radius));
         m.insert("repeat".into(), json!(self.repeat));
         m.insert("threads".into(), json!(self.threads));
@@ -250,9 +251,10 @@ impl Report {
         } else {
             format!("no sphere, faces {k}x{k}", k = c.face_grid)
         };
-        let order = match c.mode {
-            Mode::Paper => format!("order {}", c.order),
-            Mode::Accurate => format!("order {}/{}", c.order, c.singular_order),
+        let order = match (c.mode, c.tolerance) {
+            (Mode::Paper, _) => format!("order {}", c.order),
+            (Mode::Accurate, None) => format!("order {}/{}", c.order, c.singular_order),
+            (Mode::Accurate, Some(tol)) => format!("tolerance {tol:e}"),
         };
         let _ = writeln!(
             out,
@@ -411,12 +413,20 @@ impl Report {
                  (hence face sums that do not close).",
                 c.order
             ),
-            Mode::Accurate => format!(
-                "Accurate mode: pdm_kernel::pair_exchange for every patch pair: shared-edge and \
-                 shared-vertex transforms at order {}; elsewhere order {} with the visibility \
-                 boundaries (back-face cut, sphere shadow) placed into the inner rule.",
-                c.singular_order, c.order
-            ),
+            Mode::Accurate => match c.tolerance {
+                None => format!(
+                    "Accurate mode: pdm_kernel::pair_exchange for every patch pair: shared-edge and \
+                     shared-vertex transforms at order {}; elsewhere order {} with the visibility \
+                     boundaries (back-face cut, sphere shadow) placed into the inner rule.",
+                    c.singular_order, c.order
+                ),
+                Some(tol) => format!(
+                    "Tolerance mode: pdm_kernel::adaptive_exchange for every patch pair, relative \
+                     tolerance {tol:e} per pair: orders raised and pairs subdivided until the pair's \
+                     error estimate meets it (estimates by order doubling on smooth and touching \
+                     pairs, by halving across visibility boundaries)."
+                ),
+            },
         });
         notes.push(if c.radius > 0.0 {
             "Faces 1 (z=+3) and 6 (z=-3) hold the poles of the sphere's parameterisation; 2: y=-3, \
