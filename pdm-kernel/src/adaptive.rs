@@ -101,7 +101,7 @@ where
             let per_order = |p: usize| -> u64 {
                 let p4 = (p as u64).pow(4);
                 if matches!(adjacency, Adjacency::SharedEdge { .. }) {
-                    12 * p4
+                    6 * p4
                 } else {
                     4 * p4
                 }
