@@ -346,8 +346,12 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
             let from = if k == 0 { lo } else { lo + delta };
             if hi > from {
                 let span = (hi - from) / h;
-                let probes = 2 + (T::from_usize(self.probes) * span).to_f64() as usize;
-                locate_changes(&signature, from, hi, probes.max(3), out, n)?;
+                // Probes in proportion to the sub-interval's share of [s0, s1] (at least 3).
+                let mut probes = 3;
+                while probes < self.probes && T::from_usize(probes) < T::from_usize(self.probes) * span {
+                    probes += 1;
+                }
+                locate_changes(&signature, from, hi, probes, out, n)?;
             }
             lo = fixed.get(k).copied().unwrap_or(r.s1);
         }
