@@ -452,7 +452,14 @@ fn check_edge_case(case: &EdgeCase, stats: &mut Stats) -> Result<(), TestCaseErr
         let ba = exchange(&fb, &fa, s).map_err(|e| TestCaseError::fail(format!("{e:?}")))?;
         let r = rel(ba, ab);
         stats.see(if k == 0 { "reciprocity (edge)" } else { "reciprocity (other)" }, r);
-        prop_assert!(r <= if k == 0 { 1e-12 } else { 1e-13 }, "reciprocity, cell offset {k}: {ab:e} vs {ba:e}");
+        // A gapped edge pair is graded from the gap in each direction's own local maps: 2.8e-12
+        // seen (176°, gap 9e-5, order 12).
+        let allowed = match k {
+            0 if case.gap > 0.0 => 1e-11,
+            0 => 1e-12,
+            _ => 1e-13,
+        };
+        prop_assert!(r <= allowed, "reciprocity, cell offset {k}: {ab:e} vs {ba:e}");
     }
 
     // The whole pair against the contour reference.
@@ -699,11 +706,10 @@ fn touching_flat_pairs_give_finite_reciprocal_factors_in_0_1() {
     });
 }
 
-/// The same over the full range (aspect ratios up to 1e4 in every direction, 1°…179°). Fails
-/// today: see `long_strips_sharing_an_edge_are_classified_as_one_patch` and
-/// `folded_unequal_widths`.
+/// The same over the full range (aspect ratios up to 1e4 in every direction, 1°…179°). Failed
+/// before findings 1, 2 and 7 were fixed (`thin_or_folded_pairs_with_a_small_gap_…`,
+/// `folded_unequal_widths`, `thin_strips_folded_to_1_degree_as_single_patches`).
 #[test]
-#[ignore = "kernel bugs: adjacency misclassification of thin/folded pairs (F up to 3e4), fold grading for unequal widths"]
 fn touching_flat_pairs_of_any_aspect_give_finite_reciprocal_factors_in_0_1() {
     run_property("invariants, aspect up to 1e4", 256, full_range_strategy(), |(case, wide), stats| {
         if wide {
@@ -726,10 +732,10 @@ struct CurvedCase {
     motion: (f64, f64, f64, f64, [f64; 3]),
 }
 
-/// Gaps 0 or 1e-6 … 1e-3: below 1e-6 the C-41 reference itself loses digits (its X − 2 cancels:
-/// `curved_gap_reference_limit`).
+/// Gaps 0 or 1e-10 … 1e-3 (the C-41 reference is cancellation-free since the fix of
+/// `curved_gap_reference_limit`; it was limited to ≥ 1e-6 before).
 fn curved_strategy() -> impl Strategy<Value = CurvedCase> {
-    let gap = prop_oneof![1 => Just(0.0), 2 => (-6.0..=-3.0f64).prop_map(|e| 10f64.powf(e))];
+    let gap = prop_oneof![1 => Just(0.0), 2 => (-10.0..=-3.0f64).prop_map(|e| 10f64.powf(e))];
     (-0.5..=0.5f64, gap, prop_oneof![Just(4usize), Just(8usize)], motion_strategy())
         .prop_map(|(h, gap, sectors, motion)| CurvedCase { height: 10f64.powf(h), gap, sectors, motion })
 }
@@ -861,7 +867,7 @@ fn single_patch(case: &EdgeCase, order: usize) -> (Adjacency, f64, f64) {
 }
 
 #[test]
-#[ignore = "kernel bug: near contact (2 % of the largest diagonal) matches the far corners of thin or folded pairs → Identical → Separate"]
+// Fixed: near contact is relative to the shortest edge and matches the single best edge.
 fn thin_or_folded_pairs_with_a_small_gap_are_classified_as_one_patch() {
     // With exact contact these are SharedEdge (fixed in 8d729dc); lift the flap by a gap above
     // the tight tolerance and classify_near falls back to the 2 % tolerance, which also matches
@@ -879,12 +885,20 @@ fn thin_or_folded_pairs_with_a_small_gap_are_classified_as_one_patch() {
 }
 
 #[test]
-#[ignore = "kernel accuracy: one touching patch pair of aspect ≳ 16 is not resolved by the transform, and F > 1 is returned as Ok"]
+// Fixed: the transforms scale their variables by the side lengths (any aspect ratio).
 fn thin_strips_folded_to_1_degree_as_single_patches() {
-    // 23.8 × 1 strips folded to 1° (exact contact): F = 1.057 at order 8 (contour 0.9909).
+    // 23.8 × 1 strips folded to 1° (exact contact): F = 1.057 at order 8 before (contour 0.9909).
     let (adjacency, f, reference) = single_patch(&plain_case(1.0, 23.814866167165576, 1.0, 1.0, 0.0), 8);
     println!("{adjacency:?} F = {f} (contour {reference})");
     assert!((0.0..=1.0).contains(&f), "F = {f}");
+    assert!(rel(f, reference) < 1e-6, "F = {f} vs {reference}");
+    // Aspect 1 : 16 at 30° (4e-2 off at order 12 before) and a flap 1e-4 as high as the floor
+    // is wide (≈ 100 % off before), at order 12.
+    for case in [plain_case(30.0, 1.0, 16.0, 16.0, 0.0), plain_case(90.0, 1.0, 1.0, 1e-4, 0.0)] {
+        let (_, f, reference) = single_patch(&case, 12);
+        println!("l {} w {} h {}: F = {f} (contour {reference}): {:.1e}", case.l, case.w, case.h, rel(f, reference));
+        assert!(rel(f, reference) < 1e-10, "F = {f} vs {reference}");
+    }
 }
 
 #[test]
@@ -897,7 +911,7 @@ fn unit_squares_folded_to_1_degree_share_an_edge() {
 }
 
 #[test]
-#[ignore = "kernel bug: the fold grading assumes equal widths (peak at η_a = η_b, physically at w·η_a = h·η_b)"]
+// Fixed: the variables are scaled by the widths, so the peak is at equal scaled distances.
 fn folded_unequal_widths() {
     // Floor 1 × 2, flap 1 × 1 at 1° and 3°: relative errors 1.3 and 0.069 at order 12, 0.83 and
     // 0.23 at order 16, not converging; 1.1 : 1 at 1°: 1.6e-2 at order 12.
@@ -940,7 +954,8 @@ fn polar_cells_of_a_sphere_are_neighbours_not_one_patch() {
 }
 
 #[test]
-#[ignore = "kernel bug: f32 cells far from the origin (coordinates ≈ 2e4 cell sizes) are classified Identical → Ok(0)"]
+// Fixed: Identical needs the normals to agree, and a contact whose fold is not resolved by the
+// working precision is refused (Err(Degenerate)).
 fn f32_long_grid_cells_at_a_small_dihedral_angle_are_classified_identical() {
     let case = EdgeCase {
         theta_deg: 2.0163952535064036,
@@ -990,7 +1005,7 @@ fn fuzz_caller_supplied_subnormal_gap_is_slow() {
 }
 
 #[test]
-#[ignore = "reference bug (pdm_host::reference::closed_form::coaxial_disks): X − 2 cancels for h ≪ r"]
+// Fixed: coaxial_disks factors X² − 4(R₂/R₁)² with X − 2R₂/R₁ = (1 + (R₁ − R₂)²)/R₁².
 fn curved_gap_reference_limit() {
     // Equal coaxial disks: F = 1 − h/R + h²/(2R²) − …; at h = 1e-8 R the closed form returns 1.
     // (X² − 4(R₂/R₁)² = (X − 2R₂/R₁)(X + 2R₂/R₁) with X − 2R₂/R₁ = (1 + (R₁ − R₂)²)/R₁² is exact.)
@@ -1032,5 +1047,33 @@ fn fuzz_whole_sphere_and_a_parallelogram_along_its_axis() {
         ] {
             assert!(x.map_or(true, |x| x.is_finite() && x >= 0.0), "{x:?}");
         }
+    }
+}
+
+/// Error against the contour reference versus the singular order for the single-pair cases of
+/// the findings (numbers in FUZZING.md). Not a check: prints a table.
+/// `cargo test --release -p pdm-host --test fuzz_singular -- --ignored --nocapture error_versus_order`
+#[test]
+#[ignore = "measurement, prints a table"]
+fn error_versus_order() {
+    let cases: [(&str, EdgeCase); 9] = [
+        ("100 × 1 at 90°, gap 1e-5", plain_case(90.0, 100.0, 1.0, 1.0, 1e-5)),
+        ("unit squares at 1°, gap 1e-6", plain_case(1.0, 1.0, 1.0, 1.0, 1e-6)),
+        ("23.8 × 1 at 1°", plain_case(1.0, 23.814866167165576, 1.0, 1.0, 0.0)),
+        ("1 × 16 at 30° (l : w = 1 : 16)", plain_case(30.0, 1.0, 16.0, 16.0, 0.0)),
+        ("floor 1 × 1, flap 1e-4 at 90°", plain_case(90.0, 1.0, 1.0, 1e-4, 0.0)),
+        ("floor 1 × 2, flap 1 × 1 at 1°", plain_case(1.0, 1.0, 2.0, 1.0, 0.0)),
+        ("floor 1 × 2, flap 1 × 1 at 3°", plain_case(3.0, 1.0, 2.0, 1.0, 0.0)),
+        ("floor 1 × 1.1, flap 1 × 1 at 1°", plain_case(1.0, 1.0, 1.1, 1.0, 0.0)),
+        ("unit squares at 2°, gap 1e-3", plain_case(2.0, 1.0, 1.0, 1.0, 1e-3)),
+    ];
+    for (name, case) in cases {
+        let mut line = format!("{name:34}");
+        for order in [8, 12, 16, 20, 24] {
+            let start = std::time::Instant::now();
+            let (_, f, reference) = single_patch(&case, order);
+            line += &format!(" {order}: {:.1e} ({:.2} s)", rel(f, reference), start.elapsed().as_secs_f64());
+        }
+        println!("{line}");
     }
 }
