@@ -924,10 +924,12 @@ fn folded_unequal_widths() {
 }
 
 #[test]
-#[ignore = "kernel accuracy: nearly folded and nearly touching — error ∝ gap, not decreasing with the order"]
+// Fixed: the ratio grading follows the peak (the closest point of the other patch's line), and
+// ζ is also graded from the gap upwards.
 fn nearly_folded_and_nearly_touching() {
     // Unit squares at 2°, flap lifted by 1e-3 along its plane: 4.5e-6 (order 12), 6.8e-6 (16),
-    // 1.6e-5 (20), 5.8e-6 (24), 2.1e-6 (32); ≈ 1.6e-2 × gap. Without the gap: 1e-16 by order 16.
+    // 1.6e-5 (20), 5.8e-6 (24), 2.1e-6 (32) before (≈ 1.6e-2 × gap); 1.9e-10 at 20 now.
+    // Without the gap: 1e-16 by order 16.
     let (adjacency, f, reference) = single_patch(&plain_case(2.0, 1.0, 1.0, 1.0, 1e-3), 20);
     println!("{adjacency:?} F = {f} (contour {reference}): {:.1e}", rel(f, reference));
     assert!(rel(f, reference) < 1e-9, "F = {f} vs {reference}");

@@ -467,7 +467,7 @@ where
             ];
             let (ext, r0) = extents(lengths);
             let g = if r0 > T::ZERO { gap * scale / r0 } else { gap };
-            edge_sum(&la, &lb, &rule, occluders, ext, g, fold)
+            edge_sum(&la, &lb, &rule, occluders, ext, at(&lengths, 0), g, fold)
         }
         Adjacency::SharedVertex { a: ma, b: mb } => {
             let (la, lb) = (Local { patch: a, map: ma }, Local { patch: b, map: mb });
@@ -570,12 +570,14 @@ fn kernel<T: Real, O: Occluder<T> + ?Sized>(pa: Vec3<T>, na: Vec3<T>, pb: Vec3<T
     (ca * inv) * (cb * inv)
 }
 
+#[allow(clippy::too_many_arguments)]
 fn edge_sum<T, SA, SB, O>(
     a: &Local<'_, '_, T, SA>,
     b: &Local<'_, '_, T, SB>,
     rule: &GaussRule<T>,
     occ: &O,
     ext: [T; 3],
+    edge_length: T,
     gap: T,
     fold: T,
 ) -> T
@@ -592,6 +594,7 @@ where
     // m_j = min(1, ext_j/ζ) (the box cuts the pyramid beyond ζ = ext_j), ρ_j ∈ [0, 1].
     let c = ext.map(|e| T::ONE / e);
     let jac_scale = at(&c, 0) * at(&c, 1) * at(&c, 2);
+    let folded = fold > T::ZERO && fold < T::ONE;
     for pyramid in 0..3 {
         let (o1, o2) = match pyramid {
             0 => (1, 2),
@@ -599,25 +602,47 @@ where
             _ => (0, 1),
         };
         let (ek, e1, e2) = (at(&ext, pyramid), at(&ext, o1), at(&ext, o2));
-        // In pyramids 1 and 2 the kernel of two nearly folded patches peaks at ρ₁ → 0 (u = 0),
-        // ρ₂ → 1 (equal scaled distances from the edge, i.e. w_a·η_a = w_b·η_b, or the far
-        // side of the narrower patch) with width ≈ the fold angle: grade towards that corner.
-        let fold_scale = if pyramid == 0 { T::ZERO } else { fold };
+        // In pyramids 1 and 2 the kernel of two nearly folded patches peaks at ρ₁ → 0 (u = 0)
+        // and at the ρ₂ where the other patch's line comes closest to the point at distance ζ
+        // from the edge (ρ₂ = 1 for equal scaled distances without a gap; 1 − g/ζ with a gap g
+        // along the patch; the far side of the narrower patch beyond its extent), with a
+        // width ≈ (closest distance) / (length of the line): both are found per ζ node and
+        // the ρ intervals graded towards them.
+        let grade = folded && pyramid != 0;
         for_each_shell(gap, ek, &[e1, e2], |s0, s1| {
             // Beyond the narrower patch's extent (ζ > e2 ≥ 1 in pyramid 1 or 2) its free edge
-            // hovers ≈ θ·(its width) over the other patch: the kernel also peaks at ζ → e2⁺
-            // (with ρ₁ → 0, ρ₂ → 1); grade ζ towards e2 too.
-            let toward_break = if s0 == e2 && fold_scale > T::ZERO { fold_scale * s0 / (s1 - s0) } else { T::ZERO };
+            // hovers ≈ θ·(its width) over the other patch: the kernel also peaks at ζ → e2⁺;
+            // grade ζ towards e2 too. Likewise at ζ = gap, where the peak line of a gapped
+            // pair enters the pyramid.
+            let toward_break = if (s0 == e2 || s0 == gap) && grade { fold * s0 / (s1 - s0) } else { T::ZERO };
             for_each_interval(toward_break, false, |t0, t1| {
                 let (z0, z1) = (s0 + (s1 - s0) * t0, s0 + (s1 - s0) * t1);
                 let dz = z1 - z0;
-                for_each_interval(fold_scale, false, |p0, p1| {
-                    for_each_interval(fold_scale, true, |q0, q1| {
-                        let (dp, dq) = (p1 - p0, q1 - q0);
-                        for (zu, wz) in unit_points(rule) {
-                            let (zeta, wz) = (z0 + dz * zu, wz * dz);
-                            let (m1, m2) = ((e1 / zeta).min(T::ONE), (e2 / zeta).min(T::ONE));
-                            let jac = zeta * zeta * m1 * m2 * jac_scale;
+                for (zu, wz) in unit_points(rule) {
+                    let (zeta, wz) = (z0 + dz * zu, wz * dz);
+                    let (m1, m2) = ((e1 / zeta).min(T::ONE), (e2 / zeta).min(T::ONE));
+                    let jac = zeta * zeta * m1 * m2 * jac_scale;
+                    let (p_width, q_centre, q_width) = if grade {
+                        let half = T::HALF;
+                        let (point, line): (Vec3<T>, &dyn Fn(T) -> Vec3<T>) = if pyramid == 1 {
+                            (a.eval(half, (zeta * at(&c, 1)).min(T::ONE)).0, &|r: T| {
+                                b.eval(half, (zeta * m2 * r * at(&c, 2)).min(T::ONE)).0
+                            })
+                        } else {
+                            (b.eval(half, (zeta * at(&c, 2)).min(T::ONE)).0, &|r: T| {
+                                a.eval(half, (zeta * m2 * r * at(&c, 1)).min(T::ONE)).0
+                            })
+                        };
+                        let (r_star, d_min) = closest_on_line(point, line);
+                        let speed = (line(T::ONE) - line(T::ZERO)).norm();
+                        let u_length = edge_length * at(&c, 0) * zeta * m1;
+                        (ratio(d_min, u_length), r_star, ratio(d_min, speed))
+                    } else {
+                        (T::ZERO, T::ONE, T::ONE)
+                    };
+                    for_each_interval(p_width, false, |p0, p1| {
+                        for_each_interval_around(q_centre, q_width, |q0, q1| {
+                            let (dp, dq) = (p1 - p0, q1 - q0);
                             for (pu, wp) in unit_points(rule) {
                                 let (p, wp) = (p0 + dp * pu, wp * dp);
                                 for (qu, wq) in unit_points(rule) {
@@ -634,7 +659,8 @@ where
                                     let mut line = T::ZERO;
                                     for (sigma, ws) in unit_points(rule) {
                                         let lo = sigma * span;
-                                        // u > 0: ξ_a = σ(1−u), ξ_b = ξ_a + u;  u < 0: ξ_b = σ(1−|u|), ξ_a = ξ_b + |u|.
+                                        // u > 0: ξ_a = σ(1−u), ξ_b = ξ_a + u;
+                                        // u < 0: ξ_b = σ(1−|u|), ξ_a = ξ_b + |u|.
                                         let (pa, na) = a.eval(lo, eta_a);
                                         let (pb, nb) = b.eval(lo + abs_u, eta_b);
                                         let mut k = kernel(pa, na, pb, nb, occ);
@@ -646,13 +672,89 @@ where
                                     total.add(wz * wp * wq * jac * span * line);
                                 }
                             }
-                        }
+                        });
                     });
-                });
+                }
             });
         });
     }
     total.value()
+}
+
+/// `num / den` as a grading width: 1 (no grading) when the quotient is not a small positive
+/// number.
+#[inline(always)]
+fn ratio<T: Real>(num: T, den: T) -> T {
+    let r = num / den;
+    if r > T::ZERO && r < T::ONE {
+        r
+    } else {
+        T::ONE
+    }
+}
+
+/// The parameter ρ ∈ [0, 1] where `line(ρ)` comes closest to `p` and that distance, by golden
+/// section (the distance along a patch's coordinate line is unimodal for the flat and gently
+/// curved pairs that need it; an approximate centre only shifts the grading).
+fn closest_on_line<T: Real>(p: Vec3<T>, line: &dyn Fn(T) -> Vec3<T>) -> (T, T) {
+    let d = |r: T| (line(r) - p).norm();
+    let g = T::from_f64(0.381_966_011_250_105_1);
+    let (mut lo, mut hi) = (T::ZERO, T::ONE);
+    let mut x1 = lo + g * (hi - lo);
+    let mut x2 = hi - g * (hi - lo);
+    let (mut f1, mut f2) = (d(x1), d(x2));
+    for _ in 0..48 {
+        if f1 <= f2 {
+            hi = x2;
+            x2 = x1;
+            f2 = f1;
+            x1 = lo + g * (hi - lo);
+            f1 = d(x1);
+        } else {
+            lo = x1;
+            x1 = x2;
+            f1 = f2;
+            x2 = hi - g * (hi - lo);
+            f2 = d(x2);
+        }
+    }
+    // The ends too (the minimum of a monotone distance is at an end).
+    let mut best = if f1 <= f2 { (x1, f1) } else { (x2, f2) };
+    for r in [T::ZERO, T::ONE] {
+        let f = d(r);
+        if f < best.1 {
+            best = (r, f);
+        }
+    }
+    best
+}
+
+/// Calls `f(lo, hi)` for the intervals of [0, 1] graded geometrically on both sides of `centre`:
+/// [c − δ, c + δ] ∩ [0, 1], then [c + δ, c + 4δ], [c − 4δ, c − δ], …; just [0, 1] when δ is not
+/// in (0, 1) or the centre is not in [0, 1].
+fn for_each_interval_around<T: Real>(centre: T, width: T, mut f: impl FnMut(T, T)) {
+    let width = width.max(T::from_f64(1e-12));
+    if !(width < T::ONE && centre >= T::ZERO && centre <= T::ONE) {
+        f(T::ZERO, T::ONE);
+        return;
+    }
+    let four = T::from_f64(4.0);
+    let (mut lo, mut hi) = ((centre - width).max(T::ZERO), (centre + width).min(T::ONE));
+    f(lo, hi);
+    let mut step = width;
+    while hi < T::ONE {
+        step *= four;
+        let next = (centre + step).min(T::ONE);
+        f(hi, next);
+        hi = next;
+    }
+    step = width;
+    while lo > T::ZERO {
+        step *= four;
+        let next = (centre - step).max(T::ZERO);
+        f(next, lo);
+        lo = next;
+    }
 }
 
 /// Kahan–Babuška (Neumaier) compensated sum.
