@@ -19,22 +19,23 @@
 //! | check                                                | tolerance                              |
 //! |------------------------------------------------------|----------------------------------------|
 //! | F in [0, 1]                                          | 0 … 1 + 1e-9 (curved: 1 + 1e-7)        |
-//! | reciprocity per pair, f64                            | 1e-12 (touching), 1e-13 (other)        |
+//! | reciprocity per pair, f64                            | 1e-12 (touching; 1e-11 with a gap,     |
+//! |                                                      | 1e-10 below 10°), 1e-13 (other)        |
 //! | reciprocity per pair, f32                            | 1e-4                                   |
 //! | f32 vs f64, same geometry and orders, flat           | 3e-4 (θ ≥ 10°), 1e-3 (θ < 10°)         |
 //! | f32 vs f64, curved                                   | 1e-4                                   |
-//! | flat edge pairs vs contour, f64, singular order 20   | 1e-9 + 2e-2·gap (+ 5e-6 folded cells)  |
+//! | flat edge pairs vs contour, f64, singular order 16   | 1e-9                                   |
 //! | flat vertex pairs vs contour, f64, singular order 20 | 1e-9 + 2e-2·gap                        |
 //! | disk → cylinder wall vs 1 − C-41, f64, order 10      | 1e-6 + 2e-2·gap                        |
 //! | base → hemisphere dome = 1, f64, order 10            | 1e-7 + 2e-2·gap                        |
 //!
-//! Range actually asserted against the references (where the kernel is accurate today; see the
-//! `#[ignore]`d regression tests at the end for what is outside and why): flat edge pairs with
-//! w = h (floor width = flap height) for any dihedral angle in [1°, 179°], or w/h ∈ [1/2, 2] for
-//! dihedral angles ≥ 30°; edge length l/w from 1/4 to 1e4 (long edges cut into cells of length
-//! ≤ w along the edge with `PatchGrid`, summed by translation invariance). The invariant
-//! properties (finite, [0, 1], reciprocity, f32 vs f64) cover aspect ratios up to 1e4 in every
-//! direction with single patches.
+//! Range asserted against the references: flat edge pairs with w = h (floor width = flap
+//! height) or w/h ∈ [1/2, 2], any dihedral angle in [1°, 179°], gaps at any angle; edge length
+//! l/w from 1/4 to 1e4 (long edges cut into cells of length ≤ min(w, h) along the edge with
+//! `PatchGrid`, summed by translation invariance). The invariant properties (finite, [0, 1],
+//! reciprocity, f32 vs f64) cover aspect ratios up to 1e4 in every direction with single
+//! patches. The regression tests at the end reproduce what the properties and the fuzzer found
+//! (pdm-host/FUZZING.md, "Findings").
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing, missing_docs)]
 
 use std::cell::RefCell;
@@ -362,14 +363,11 @@ fn edge_case_strategy() -> impl Strategy<Value = EdgeCase> {
     let shape = prop_oneof![
         // w = h, any dihedral angle
         (1.0..=179.0f64, Just(0.0)),
-        // w ≠ h, dihedral ≥ 30°
-        (30.0..=179.0f64, -LOG10_2..=LOG10_2),
+        // w ≠ h, any dihedral angle (was ≥ 30° until finding 2 was fixed)
+        (1.0..=179.0f64, -LOG10_2..=LOG10_2),
     ];
     (shape, -2.0 * LOG10_2..=4.0f64, gap_strategy(), motion_strategy(), 0..8u8, 0..8u8).prop_map(
         |((theta_deg, log_w_over_h), log_l, gap, motion, variant_floor, variant_flap)| {
-            // Below 2° only exact contact: a gap sends the pair through the near-contact
-            // tolerance, which misclassifies it (see the ignored regression tests).
-            let gap = if theta_deg < 2.0 { 0.0 } else { gap };
             let w = 1.0;
             let h = 10f64.powf(-log_w_over_h);
             let l = 10f64.powf(log_l) * w.min(h);
@@ -438,7 +436,9 @@ fn check_edge_case(case: &EdgeCase, stats: &mut Stats) -> Result<(), TestCaseErr
         }
     }
     // touching_exchange directly = pair_exchange.
-    let singular_order = 20;
+    // Order 16: edge pairs and the vertex neighbours of cells are at ≤ 3e-14 by then (the
+    // graded transforms converge exponentially), and it keeps the CI time down.
+    let singular_order = 16;
     // (Reciprocity and the direct call hold at any order: checked at 12, cheaper.)
     let direct = touching_exchange(&a0, &b0, near, gap, 12, &()).map_err(|e| TestCaseError::fail(format!("{e:?}")))?;
     let paired = exchange(&a0, &b0, settings(16, 12)).map_err(|e| TestCaseError::fail(format!("{e:?}")))?;
@@ -452,9 +452,11 @@ fn check_edge_case(case: &EdgeCase, stats: &mut Stats) -> Result<(), TestCaseErr
         let ba = exchange(&fb, &fa, s).map_err(|e| TestCaseError::fail(format!("{e:?}")))?;
         let r = rel(ba, ab);
         stats.see(if k == 0 { "reciprocity (edge)" } else { "reciprocity (other)" }, r);
-        // A gapped edge pair is graded from the gap in each direction's own local maps: 2.8e-12
-        // seen (176°, gap 9e-5, order 12).
+        // Each direction grades in its own local maps (from the gap, towards the peak it finds),
+        // so reciprocity is only as good as the order-12 result: 2.8e-12 seen at 176° with a gap
+        // of 9e-5, 1.8e-11 at 1° (unit squares at 1°: 9.3e-12 off at order 12).
         let allowed = match k {
+            0 if case.theta_deg < 10.0 => 1e-10,
             0 if case.gap > 0.0 => 1e-11,
             0 => 1e-12,
             _ => 1e-13,
@@ -472,12 +474,11 @@ fn check_edge_case(case: &EdgeCase, stats: &mut Stats) -> Result<(), TestCaseErr
     let reference = contour::polygon_form_factor(&pf, &pp);
     let e = rel(f, reference);
     stats.see("vs contour", e);
-    // Nearly folded and nearly touching: an error ∝ the gap (≈ 1.6e-2·gap at 2°, not decreasing
-    // with the order; reported), so the gap enters the tolerance.
-    // Neighbouring cells along a nearly folded edge (θ < 10°) share a vertex, and the vertex
-    // transform has no fold grading: algebraic convergence, 1.6e-6 at singular order 20 and 2°.
-    let folded_cells = if n >= 2 && case.theta_deg < 10.0 { 5e-6 } else { 0.0 };
-    let allowed = 1e-9 + 2e-2 * case.gap + folded_cells;
+    // Nearly folded and nearly touching pairs used to be ≈ 1.6e-2·gap off (finding 3), and the
+    // gap entered the tolerance; neighbouring cells along a nearly folded edge (θ < 10°, sharing
+    // a vertex) were 1.6e-6 off at order 20 and 2° (finding 5), allowed 5e-6. Since the ratio
+    // grading follows the peak (edge and vertex transforms) neither needs an allowance.
+    let allowed = 1e-9;
     prop_assert!(e <= allowed, "F = {f:.15e}, contour {reference:.15e}: relative error {e:.2e} > {allowed:.1e}");
 
     Ok(())
@@ -1021,14 +1022,15 @@ fn curved_gap_reference_limit() {
 #[test]
 fn long_edge_folded_to_2_degrees_cut_into_cells() {
     // The edge property's shrunk worst case: 504 cells along the edge at 2°. The vertex
-    // neighbours converge algebraically (no fold grading in the vertex transform).
+    // neighbours converged algebraically before the vertex transform graded towards the peak
+    // (1.6e-6 at order 20; 2.0e-14 since).
     let case = EdgeCase { variant_flap: 2, ..plain_case(2.0, 503.9195016890531, 1.0, 1.0, 0.0) };
     let (floor, flap) = case.build::<f64>().unwrap();
     let f = edge_sum(&floor, &flap, case.cells(), 20).unwrap() / (case.l * case.w);
     let (pf, pp) = case.polygons();
     let reference = contour::polygon_form_factor(&pf, &pp);
     println!("F = {f} (contour {reference}): {:.1e}", rel(f, reference));
-    assert!(rel(f, reference) < 5e-6);
+    assert!(rel(f, reference) < 1e-12, "{f} vs {reference}");
 }
 
 #[test]
@@ -1059,7 +1061,8 @@ fn fuzz_whole_sphere_and_a_parallelogram_along_its_axis() {
 #[test]
 #[ignore = "measurement, prints a table"]
 fn error_versus_order() {
-    let cases: [(&str, EdgeCase); 9] = [
+    let cases: [(&str, EdgeCase); 10] = [
+        ("unit squares at 1°", plain_case(1.0, 1.0, 1.0, 1.0, 0.0)),
         ("100 × 1 at 90°, gap 1e-5", plain_case(90.0, 100.0, 1.0, 1.0, 1e-5)),
         ("unit squares at 1°, gap 1e-6", plain_case(1.0, 1.0, 1.0, 1.0, 1e-6)),
         ("23.8 × 1 at 1°", plain_case(1.0, 23.814866167165576, 1.0, 1.0, 0.0)),
@@ -1075,6 +1078,20 @@ fn error_versus_order() {
         for order in [8, 12, 16, 20, 24] {
             let start = std::time::Instant::now();
             let (_, f, reference) = single_patch(&case, order);
+            line += &format!(" {order}: {:.1e} ({:.2} s)", rel(f, reference), start.elapsed().as_secs_f64());
+        }
+        println!("{line}");
+    }
+    // Cells along an edge folded to 2° and 1° (finding 5: the vertex neighbours).
+    for deg in [2.0, 1.0] {
+        let case = EdgeCase { variant_flap: 2, ..plain_case(deg, 503.9195016890531, 1.0, 1.0, 0.0) };
+        let (floor, flap) = case.build::<f64>().unwrap();
+        let (pf, pp) = case.polygons();
+        let reference = contour::polygon_form_factor(&pf, &pp);
+        let mut line = format!("{:34}", format!("504 unit cells at {deg}°"));
+        for order in [8, 12, 16, 20, 24] {
+            let start = std::time::Instant::now();
+            let f = edge_sum(&floor, &flap, case.cells(), order).unwrap() / (case.l * case.w);
             line += &format!(" {order}: {:.1e} ({:.2} s)", rel(f, reference), start.elapsed().as_secs_f64());
         }
         println!("{line}");
