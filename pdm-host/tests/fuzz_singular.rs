@@ -455,12 +455,16 @@ fn check_edge_case(case: &EdgeCase, stats: &mut Stats) -> Result<(), TestCaseErr
         // Each direction grades in its own local maps (from the gap, towards the peak it finds),
         // so reciprocity is only as good as the order-12 result: 2.8e-12 seen at 176° with a gap
         // of 9e-5, 1.8e-11 at 1° (unit squares at 1°: 9.3e-12 off at order 12).
-        let allowed = match k {
-            0 if case.theta_deg < 10.0 => 1e-10,
-            0 if case.gap > 0.0 => 1e-11,
-            0 => 1e-12,
-            _ => 1e-13,
-        };
+        // Plus the rounding of the coordinates (cells ≈ 7e4 cell sizes from the origin: 1.4e-12
+        // at 73°, seed 7).
+        let rounding = 8.0 * f64::EPSILON * magnitude / diag;
+        let allowed = rounding
+            + match k {
+                0 if case.theta_deg < 10.0 => 1e-10,
+                0 if case.gap > 0.0 => 1e-11,
+                0 => 1e-12,
+                _ => 1e-13,
+            };
         prop_assert!(r <= allowed, "reciprocity, cell offset {k}: {ab:e} vs {ba:e}");
     }
 
@@ -670,19 +674,54 @@ fn check_invariants<T: Real>(case: &EdgeCase, stats: &mut Stats) -> Result<(), T
     let (a, b) = (floor.cell(0, 1), flap.cell(0, 1));
     let _ = (classify(&a, &b), classify_near(&a, &b));
     let s = settings(8, 12);
-    let ab = exchange(&a, &b, s).map_err(|e| TestCaseError::fail(format!("{e:?}")))?;
-    let ba = exchange(&b, &a, s).map_err(|e| TestCaseError::fail(format!("{e:?}")))?;
+    let wide = T::MANTISSA_DIGITS > 24;
+    // f32 only: a contact the working precision does not resolve (rounding of the coordinates
+    // not small against the shortest edge × the fold angle) is refused with Err(Degenerate)
+    // (finding 6). Counted; the same Err both ways.
+    let (ab, ba) = match (exchange(&a, &b, s), exchange(&b, &a, s)) {
+        (Ok(ab), Ok(ba)) => (ab, ba),
+        (Err(PdmError::Degenerate), Err(PdmError::Degenerate))
+            if !wide && !matches!(classify_near(&a, &b).0, Adjacency::Separate) =>
+        {
+            stats.see(
+                "f32 refused as unresolvable (count)",
+                stats
+                    .max
+                    .iter()
+                    .find(|(n, _, _)| *n == "f32 refused as unresolvable (count)")
+                    .map_or(1.0, |(_, m, _)| m + 1.0),
+            );
+            return Ok(());
+        }
+        (x, y) => return Err(TestCaseError::fail(format!("{x:?} / {y:?}"))),
+    };
     let m = case.motion();
     let s2 = m.scale * m.scale;
     let (f_ab, f_ba) = (ab / (case.l * case.w * s2), ab / (case.l * case.h * s2));
-    let wide = T::MANTISSA_DIGITS > 24;
     stats.see(if wide { "F max (f64)" } else { "F max (f32)" }, f_ab.max(f_ba));
     prop_assert!(f_ab.is_finite() && f_ba.is_finite(), "not finite: {f_ab} {f_ba}");
-    prop_assert!((0.0..=1.0 + 1e-9).contains(&f_ab), "F(floor → flap) = {f_ab}");
-    prop_assert!((0.0..=1.0 + 1e-9).contains(&f_ba), "F(flap → floor) = {f_ba}");
+    // f32 below 10°: a nearly folded pair is ≈ 1/θ times as sensitive to the rounding of its
+    // geometry (as in the f32-vs-f64 property): F = 1.00013 and reciprocity 2.0e-4 were seen at
+    // 1° (l = 61, w = 0.42, h = 1, coordinates ≈ 600 cell widths, f32 rounding 1.7e-4 of a cell;
+    // seed 7, only reachable in the unfiltered range).
+    let small = case.theta_deg < 10.0;
+    let f_tol = match (wide, small) {
+        (true, _) => 1e-9,
+        (false, true) => 1e-3,
+        (false, false) => 1e-5,
+    };
+    prop_assert!((0.0..=1.0 + f_tol).contains(&f_ab), "F(floor → flap) = {f_ab}");
+    prop_assert!((0.0..=1.0 + f_tol).contains(&f_ba), "F(flap → floor) = {f_ba}");
     let r = rel(ba, ab);
     stats.see(if wide { "reciprocity (f64)" } else { "reciprocity (f32)" }, r);
-    prop_assert!(r <= if wide { 1e-12 } else { 1e-4 }, "reciprocity {ab:e} vs {ba:e}");
+    // f64: each direction grades in its own local maps (1e-10 below 10°, see the edge property).
+    let r_tol = match (wide, small) {
+        (true, false) => 1e-12,
+        (true, true) => 1e-10,
+        (false, false) => 1e-4,
+        (false, true) => 1e-3,
+    };
+    prop_assert!(r <= r_tol, "reciprocity {ab:e} vs {ba:e}");
     Ok(())
 }
 
