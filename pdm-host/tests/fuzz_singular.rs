@@ -725,9 +725,10 @@ fn check_invariants<T: Real>(case: &EdgeCase, stats: &mut Stats) -> Result<(), T
     Ok(())
 }
 
-/// Where adjacency detection is sound today: no corner of one patch within 10 % of the larger
-/// diagonal of a corner of the other except the shared ones, and w = h below 30° (the fold
-/// grading assumes equal widths).
+/// Where adjacency detection was sound before findings 1, 2 and 7 were fixed (kept as a
+/// property of its own; the unfiltered one below covers the rest): no corner of one patch within
+/// 10 % of the larger diagonal of a corner of the other except the shared ones, and w = h below
+/// 30° (the fold grading assumed equal widths).
 fn classifiable(c: &EdgeCase) -> bool {
     let diag = (c.l * c.l + c.w.max(c.h).powi(2)).sqrt();
     let far = (c.w * c.w + c.h * c.h - 2.0 * c.w * c.h * c.theta_deg.to_radians().cos()).sqrt();
@@ -891,8 +892,9 @@ fn curved_touching_pairs_against_closed_forms() {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Regression tests: what the properties and the fuzzer found (pdm-host/FUZZING.md). Those marked
-// `#[ignore]` reproduce open bugs: they assert the correct behaviour and fail today.
+// Regression tests: what the properties and the fuzzer found (pdm-host/FUZZING.md, "Findings"),
+// all fixed; an open bug's reproducer would be marked `#[ignore]` and assert the correct
+// behaviour. `error_versus_order` (ignored) only prints the measurements.
 
 fn plain_case(theta_deg: f64, l: f64, w: f64, h: f64, gap: f64) -> EdgeCase {
     EdgeCase { theta_deg, l, w, h, gap, motion: (1.0, 0.0, 0.0, 0.0, [0.0; 3]), variant_floor: 0, variant_flap: 0 }

@@ -16,10 +16,25 @@
 //! tensor Gauss rule converges exponentially: machine precision for perpendicular unit squares
 //! by order ≈ 12.
 //!
+//! **Any aspect ratio.** The variables are scaled by the physical side lengths (edge length L,
+//! widths w_a, w_b; at a vertex the four sides) over the shortest side r₀, so the box of scaled
+//! variables is [0, L/r₀] × [0, w_a/r₀] × [0, w_b/r₀]: the cube [0, 1]³ near the edge is
+//! physically a cube and gets the pyramids above; the rest of each pyramid (the box cuts it
+//! where ζ exceeds another side's extent; the ratios then run to min(1, extent/ζ)) is covered by
+//! shells ζ ∈ [1, 4], [4, 16], … with breaks at the other extents. This is the cut of a long
+//! pair into near-square sub-pairs done inside the transform, allocation-free, at O(log aspect)
+//! extra shells (fuzz finding 7).
+//!
 //! **Nearly folded pairs.** When the dihedral angle θ between the two patches is small (their
-//! normals at the edge nearly opposite), the kernel inside two of the pyramids peaks in a corner
-//! with width ≈ θ; those pyramids' inner variables are then split geometrically towards that
-//! corner (θ, 4θ, 16θ, …), which keeps the convergence exponential down to θ ≈ 1°.
+//! normals at the edge nearly opposite), the kernel inside two of the pyramids peaks along the
+//! line where the other patch comes closest (equal scaled distances from the edge; 1 − g/ζ with a
+//! gap g; the far side of the narrower patch beyond its width) with width ≈ θ. Per ζ node that
+//! closest point is found on the other patch's coordinate line (golden section) and the ratio
+//! variables are split geometrically around it and towards u = 0 (widths: closest distance /
+//! line length), and ζ is also split upwards from the narrower side's extent and from the gap:
+//! exponential convergence down to θ ≈ 1°, with or without a gap (findings 2 and 3). Vertex
+//! pairs do the same when one patch's edge from the vertex comes close to one of the other's
+//! (cells along a nearly folded edge, finding 5).
 //!
 //! **Shared vertex.** Both patches are mapped so that the common corner is (0, 0); the 4-cube is
 //! split into four pyramids by its largest coordinate, Jacobian ζ³ (the singularity is 1/ζ²).
@@ -28,10 +43,15 @@
 //! handled by the same transforms with the ζ-interval split geometrically down to the gap, so the
 //! near-singular peak is resolved (error bounded independently of the gap).
 //!
-//! Adjacency is detected from the geometry ([`classify`]): corners closer than
-//! `ADJACENCY_TOLERANCE × patch size + 16 ε × coordinate magnitude` coincide; an edge is shared
-//! when both its corners coincide and its quarter, mid and three-quarter points do too (so the
-//! two parameterisations agree along it, as the transform requires).
+//! Adjacency is detected from the geometry ([`classify`], [`classify_near`]): one to one, the
+//! single best match — the edge of A and edge of B (either direction) whose end points are
+//! closest, else the closest pair of corners — within `ADJACENCY_TOLERANCE × patch size +
+//! 16 ε × coordinate magnitude` (exact contact) or [`NEAR_CONTACT`] × the shortest edge (near
+//! contact; then also clearly the closest pair); an edge is shared when its quarter, mid and
+//! three-quarter points coincide too (so the two parameterisations agree along it, as the
+//! transform requires). `Identical` needs all four corners, the centres and the normals there to
+//! agree. A contact the working precision cannot resolve (the rounding band not small against
+//! the shortest edge × the fold angle) is refused with `Err(Degenerate)` (finding 6).
 
 use crate::error::PdmError;
 use crate::gauss::GaussRule;
