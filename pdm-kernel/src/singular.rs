@@ -188,8 +188,9 @@ pub const NEAR_CONTACT: f64 = 0.02;
 /// to the patch size — the larger of the two patches' diagonals; 0 up to rounding for patches
 /// that truly touch).
 ///
-/// A NaN gap means the contact cannot be resolved in the working precision (the rounding of the
-/// coordinates, 16 ε × their magnitude, is not small against the patches: f32 cells far from the
+/// A gap of `T::MAX` (finite, so callers that check the gap see a number) means the contact
+/// cannot be resolved in the working precision (the rounding of the coordinates, 16 ε × their
+/// magnitude, is not small against the shortest edge × the fold angle: f32 cells far from the
 /// origin); [`touching_exchange`] then refuses the pair with `Err(Degenerate)` rather than
 /// return a silently wrong value.
 #[must_use]
@@ -205,11 +206,7 @@ where
     if exact != Adjacency::Separate {
         // Touching within the tight tolerance (or the same patch). A gap below the tolerance but
         // above rounding is still graded for.
-        let gap = if exact == Adjacency::Identical || !(exact_gap > rounding || is_nan(exact_gap)) {
-            T::ZERO
-        } else {
-            exact_gap
-        };
+        let gap = if exact == Adjacency::Identical || !(exact_gap > rounding) { T::ZERO } else { exact_gap };
         return (exact, gap);
     }
     let (adjacency, gap) = contact(a, b, true);
@@ -217,13 +214,7 @@ where
         // Nearly coincident but not the same patch: no transform applies.
         return (Adjacency::Separate, T::ZERO);
     }
-    (adjacency, if gap > rounding || is_nan(gap) { gap } else { T::ZERO })
-}
-
-/// NaN test through `Real` (NaN is the only value not ≥ 0 in absolute value).
-#[inline(always)]
-fn is_nan<T: Real>(x: T) -> bool {
-    !(x.abs() >= T::ZERO)
+    (adjacency, if gap > rounding { gap } else { T::ZERO })
 }
 
 /// Largest corner-to-corner distance of a patch.
@@ -265,7 +256,7 @@ fn shortest_edge<T: Real>(c: &[Vec3<T>; 4], collapsed: T) -> T {
 const RESOLUTION: f64 = 1.0 / 32.0;
 
 /// Adjacency at the tight tolerance (`near` = false: [`adjacency_tolerance`] × patch size) or the
-/// near-contact one, and the relative gap of the matched points (NaN: unresolvable).
+/// near-contact one, and the relative gap of the matched points (`T::MAX`: unresolvable).
 ///
 /// Matching is one to one and picks the single best candidate: the edge of A and edge of B
 /// (either direction) whose end points are closest (the larger of the two distances), else the
@@ -311,14 +302,14 @@ where
         }
     };
     // The geometry is resolved when the rounding band is small against every edge (times the
-    // fold parameter for an edge pair); otherwise a contact found is reported with a NaN gap
+    // fold parameter for an edge pair); otherwise a contact found is reported with the gap `T::MAX`
     // (refused by touching_exchange).
     let flag = |adjacency: Adjacency, gap: T, sensitivity: T| {
         let resolved = shortest < T::MAX && band <= T::from_f64(RESOLUTION) * shortest * sensitivity.min(T::ONE);
         if resolved {
             (adjacency, gap)
         } else {
-            (adjacency, T::from_f64(f64::NAN))
+            (adjacency, T::MAX)
         }
     };
 
@@ -455,7 +446,7 @@ fn unit_points<T: Real>(rule: &GaussRule<T>) -> impl Iterator<Item = (T, T)> + '
 /// transforms in the module docs with the `order`-point rule on each of the four variables.
 /// `gap` is the relative gap from [`classify_near`] (0 for patches that truly touch): for a
 /// positive gap the radial variable ζ is split geometrically at gap·4ᵏ so the near-singular
-/// peak is resolved. A NaN gap (contact not resolvable in the working precision, see
+/// peak is resolved. A gap of `T::MAX` (contact not resolvable in the working precision, see
 /// [`classify_near`]) is refused with `Err(Degenerate)`.
 /// `Separate` pairs are refused (`Err(Degenerate)`) — use the plain sum for them; `Identical`
 /// pairs too (a patch's own F_ii needs [`crate::self_form_factor`]).
@@ -484,7 +475,7 @@ where
     O: Occluder<T> + ?Sized,
 {
     let rule = GaussRule::<T>::new(order)?;
-    if is_nan(gap) {
+    if gap >= T::MAX {
         return Err(PdmError::Degenerate);
     }
     // A gap at the level of rounding is no gap (and a subnormal one would make hundreds of
