@@ -19,22 +19,23 @@
 //! | check                                                | tolerance                              |
 //! |------------------------------------------------------|----------------------------------------|
 //! | F in [0, 1]                                          | 0 … 1 + 1e-9 (curved: 1 + 1e-7)        |
-//! | reciprocity per pair, f64                            | 1e-12 (touching), 1e-13 (other)        |
+//! | reciprocity per pair, f64                            | 1e-12 (touching; 1e-11 with a gap,     |
+//! |                                                      | 1e-10 below 10°), 1e-13 (other)        |
 //! | reciprocity per pair, f32                            | 1e-4                                   |
 //! | f32 vs f64, same geometry and orders, flat           | 3e-4 (θ ≥ 10°), 1e-3 (θ < 10°)         |
 //! | f32 vs f64, curved                                   | 1e-4                                   |
-//! | flat edge pairs vs contour, f64, singular order 20   | 1e-9 + 2e-2·gap (+ 5e-6 folded cells)  |
-//! | flat vertex pairs vs contour, f64, singular order 20 | 1e-5 + 2e-2·gap                        |
-//! | disk → cylinder wall vs 1 − C-41, f64, order 10      | 1e-6 + 2e-2·gap                        |
-//! | base → hemisphere dome = 1, f64, order 10            | 1e-7 + 2e-2·gap                        |
+//! | flat edge pairs vs contour, f64, singular order 16   | 1e-9                                   |
+//! | flat vertex pairs vs contour, f64, singular order 20 | 1e-9                                   |
+//! | disk → cylinder wall vs 1 − C-41, f64, order 10      | 1e-6                                   |
+//! | base → hemisphere dome = 1, f64, order 10            | 1e-7                                   |
 //!
-//! Range actually asserted against the references (where the kernel is accurate today; see the
-//! `#[ignore]`d regression tests at the end for what is outside and why): flat edge pairs with
-//! w = h (floor width = flap height) for any dihedral angle in [1°, 179°], or w/h ∈ [1/2, 2] for
-//! dihedral angles ≥ 30°; edge length l/w from 1/4 to 1e4 (long edges cut into cells of length
-//! ≤ w along the edge with `PatchGrid`, summed by translation invariance). The invariant
-//! properties (finite, [0, 1], reciprocity, f32 vs f64) cover aspect ratios up to 1e4 in every
-//! direction with single patches.
+//! Range asserted against the references: flat edge pairs with w = h (floor width = flap
+//! height) or w/h ∈ [1/2, 2], any dihedral angle in [1°, 179°], gaps at any angle; edge length
+//! l/w from 1/4 to 1e4 (long edges cut into cells of length ≤ min(w, h) along the edge with
+//! `PatchGrid`, summed by translation invariance). The invariant properties (finite, [0, 1],
+//! reciprocity, f32 vs f64) cover aspect ratios up to 1e4 in every direction with single
+//! patches. The regression tests at the end reproduce what the properties and the fuzzer found
+//! (pdm-host/FUZZING.md, "Findings").
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing, missing_docs)]
 
 use std::cell::RefCell;
@@ -362,14 +363,11 @@ fn edge_case_strategy() -> impl Strategy<Value = EdgeCase> {
     let shape = prop_oneof![
         // w = h, any dihedral angle
         (1.0..=179.0f64, Just(0.0)),
-        // w ≠ h, dihedral ≥ 30°
-        (30.0..=179.0f64, -LOG10_2..=LOG10_2),
+        // w ≠ h, any dihedral angle (was ≥ 30° until finding 2 was fixed)
+        (1.0..=179.0f64, -LOG10_2..=LOG10_2),
     ];
     (shape, -2.0 * LOG10_2..=4.0f64, gap_strategy(), motion_strategy(), 0..8u8, 0..8u8).prop_map(
         |((theta_deg, log_w_over_h), log_l, gap, motion, variant_floor, variant_flap)| {
-            // Below 2° only exact contact: a gap sends the pair through the near-contact
-            // tolerance, which misclassifies it (see the ignored regression tests).
-            let gap = if theta_deg < 2.0 { 0.0 } else { gap };
             let w = 1.0;
             let h = 10f64.powf(-log_w_over_h);
             let l = 10f64.powf(log_l) * w.min(h);
@@ -438,7 +436,9 @@ fn check_edge_case(case: &EdgeCase, stats: &mut Stats) -> Result<(), TestCaseErr
         }
     }
     // touching_exchange directly = pair_exchange.
-    let singular_order = 20;
+    // Order 16: edge pairs and the vertex neighbours of cells are at ≤ 3e-14 by then (the
+    // graded transforms converge exponentially), and it keeps the CI time down.
+    let singular_order = 16;
     // (Reciprocity and the direct call hold at any order: checked at 12, cheaper.)
     let direct = touching_exchange(&a0, &b0, near, gap, 12, &()).map_err(|e| TestCaseError::fail(format!("{e:?}")))?;
     let paired = exchange(&a0, &b0, settings(16, 12)).map_err(|e| TestCaseError::fail(format!("{e:?}")))?;
@@ -452,7 +452,20 @@ fn check_edge_case(case: &EdgeCase, stats: &mut Stats) -> Result<(), TestCaseErr
         let ba = exchange(&fb, &fa, s).map_err(|e| TestCaseError::fail(format!("{e:?}")))?;
         let r = rel(ba, ab);
         stats.see(if k == 0 { "reciprocity (edge)" } else { "reciprocity (other)" }, r);
-        prop_assert!(r <= if k == 0 { 1e-12 } else { 1e-13 }, "reciprocity, cell offset {k}: {ab:e} vs {ba:e}");
+        // Each direction grades in its own local maps (from the gap, towards the peak it finds),
+        // so reciprocity is only as good as the order-12 result: 2.8e-12 seen at 176° with a gap
+        // of 9e-5, 1.8e-11 at 1° (unit squares at 1°: 9.3e-12 off at order 12).
+        // Plus the rounding of the coordinates (cells ≈ 7e4 cell sizes from the origin: 1.4e-12
+        // at 73°, seed 7).
+        let rounding = 8.0 * f64::EPSILON * magnitude / diag;
+        let allowed = rounding
+            + match k {
+                0 if case.theta_deg < 10.0 => 1e-10,
+                0 if case.gap > 0.0 => 1e-11,
+                0 => 1e-12,
+                _ => 1e-13,
+            };
+        prop_assert!(r <= allowed, "reciprocity, cell offset {k}: {ab:e} vs {ba:e}");
     }
 
     // The whole pair against the contour reference.
@@ -465,12 +478,11 @@ fn check_edge_case(case: &EdgeCase, stats: &mut Stats) -> Result<(), TestCaseErr
     let reference = contour::polygon_form_factor(&pf, &pp);
     let e = rel(f, reference);
     stats.see("vs contour", e);
-    // Nearly folded and nearly touching: an error ∝ the gap (≈ 1.6e-2·gap at 2°, not decreasing
-    // with the order; reported), so the gap enters the tolerance.
-    // Neighbouring cells along a nearly folded edge (θ < 10°) share a vertex, and the vertex
-    // transform has no fold grading: algebraic convergence, 1.6e-6 at singular order 20 and 2°.
-    let folded_cells = if n >= 2 && case.theta_deg < 10.0 { 5e-6 } else { 0.0 };
-    let allowed = 1e-9 + 2e-2 * case.gap + folded_cells;
+    // Nearly folded and nearly touching pairs used to be ≈ 1.6e-2·gap off (finding 3), and the
+    // gap entered the tolerance; neighbouring cells along a nearly folded edge (θ < 10°, sharing
+    // a vertex) were 1.6e-6 off at order 20 and 2° (finding 5), allowed 5e-6. Since the ratio
+    // grading follows the peak (edge and vertex transforms) neither needs an allowance.
+    let allowed = 1e-9;
     prop_assert!(e <= allowed, "F = {f:.15e}, contour {reference:.15e}: relative error {e:.2e} > {allowed:.1e}");
 
     Ok(())
@@ -616,9 +628,11 @@ fn check_vertex_case(case: &VertexCase, stats: &mut Stats) -> Result<(), TestCas
     let reference = contour::polygon_form_factor(&poly(f), &poly(o));
     let e = rel(f_ab, reference);
     stats.see("vs contour", e);
-    // The vertex transform has no grading: sizes up to 1 : 3.4 at 30° (an edge of each patch
-    // leaving the vertex 30° apart) are 3.3e-6 off at order 20.
-    let allowed = 1e-5 + 2e-2 * case.gap;
+    // Sizes up to 1 : 3.4 at 30° (an edge of each patch leaving the vertex 30° apart) were
+    // 3.3e-6 off at order 20 before the transform scaled its variables by the side lengths;
+    // 1.2e-12 since (CI seed), 1e-9 allowed.
+    // (The 2e-2·gap term of finding 3 was dropped with its fix: gapped cases are within 1e-9.)
+    let allowed = 1e-9;
     prop_assert!(e <= allowed, "F = {f_ab:.15e}, contour {reference:.15e}: {e:.2e} > {allowed:.1e}");
     // f32, same orders as a cheaper f64 run.
     let floor32 = Rect::<f32>::new(f[0], f[1], f[2], f[1], case.variant_floor, &m).map_err(fail)?;
@@ -661,25 +675,61 @@ fn check_invariants<T: Real>(case: &EdgeCase, stats: &mut Stats) -> Result<(), T
     let (a, b) = (floor.cell(0, 1), flap.cell(0, 1));
     let _ = (classify(&a, &b), classify_near(&a, &b));
     let s = settings(8, 12);
-    let ab = exchange(&a, &b, s).map_err(|e| TestCaseError::fail(format!("{e:?}")))?;
-    let ba = exchange(&b, &a, s).map_err(|e| TestCaseError::fail(format!("{e:?}")))?;
+    let wide = T::MANTISSA_DIGITS > 24;
+    // f32 only: a contact the working precision does not resolve (rounding of the coordinates
+    // not small against the shortest edge × the fold angle) is refused with Err(Degenerate)
+    // (finding 6). Counted; the same Err both ways.
+    let (ab, ba) = match (exchange(&a, &b, s), exchange(&b, &a, s)) {
+        (Ok(ab), Ok(ba)) => (ab, ba),
+        (Err(PdmError::Degenerate), Err(PdmError::Degenerate))
+            if !wide && !matches!(classify_near(&a, &b).0, Adjacency::Separate) =>
+        {
+            stats.see(
+                "f32 refused as unresolvable (count)",
+                stats
+                    .max
+                    .iter()
+                    .find(|(n, _, _)| *n == "f32 refused as unresolvable (count)")
+                    .map_or(1.0, |(_, m, _)| m + 1.0),
+            );
+            return Ok(());
+        }
+        (x, y) => return Err(TestCaseError::fail(format!("{x:?} / {y:?}"))),
+    };
     let m = case.motion();
     let s2 = m.scale * m.scale;
     let (f_ab, f_ba) = (ab / (case.l * case.w * s2), ab / (case.l * case.h * s2));
-    let wide = T::MANTISSA_DIGITS > 24;
     stats.see(if wide { "F max (f64)" } else { "F max (f32)" }, f_ab.max(f_ba));
     prop_assert!(f_ab.is_finite() && f_ba.is_finite(), "not finite: {f_ab} {f_ba}");
-    prop_assert!((0.0..=1.0 + 1e-9).contains(&f_ab), "F(floor → flap) = {f_ab}");
-    prop_assert!((0.0..=1.0 + 1e-9).contains(&f_ba), "F(flap → floor) = {f_ba}");
+    // f32 below 10°: a nearly folded pair is ≈ 1/θ times as sensitive to the rounding of its
+    // geometry (as in the f32-vs-f64 property): F = 1.00013 and reciprocity 2.0e-4 were seen at
+    // 1° (l = 61, w = 0.42, h = 1, coordinates ≈ 600 cell widths, f32 rounding 1.7e-4 of a cell;
+    // seed 7, only reachable in the unfiltered range).
+    let small = case.theta_deg < 10.0;
+    let f_tol = match (wide, small) {
+        (true, _) => 1e-9,
+        (false, true) => 1e-3,
+        (false, false) => 1e-5,
+    };
+    prop_assert!((0.0..=1.0 + f_tol).contains(&f_ab), "F(floor → flap) = {f_ab}");
+    prop_assert!((0.0..=1.0 + f_tol).contains(&f_ba), "F(flap → floor) = {f_ba}");
     let r = rel(ba, ab);
     stats.see(if wide { "reciprocity (f64)" } else { "reciprocity (f32)" }, r);
-    prop_assert!(r <= if wide { 1e-12 } else { 1e-4 }, "reciprocity {ab:e} vs {ba:e}");
+    // f64: each direction grades in its own local maps (1e-10 below 10°, see the edge property).
+    let r_tol = match (wide, small) {
+        (true, false) => 1e-12,
+        (true, true) => 1e-10,
+        (false, false) => 1e-4,
+        (false, true) => 1e-3,
+    };
+    prop_assert!(r <= r_tol, "reciprocity {ab:e} vs {ba:e}");
     Ok(())
 }
 
-/// Where adjacency detection is sound today: no corner of one patch within 10 % of the larger
-/// diagonal of a corner of the other except the shared ones, and w = h below 30° (the fold
-/// grading assumes equal widths).
+/// Where adjacency detection was sound before findings 1, 2 and 7 were fixed (kept as a
+/// property of its own; the unfiltered one below covers the rest): no corner of one patch within
+/// 10 % of the larger diagonal of a corner of the other except the shared ones, and w = h below
+/// 30° (the fold grading assumed equal widths).
 fn classifiable(c: &EdgeCase) -> bool {
     let diag = (c.l * c.l + c.w.max(c.h).powi(2)).sqrt();
     let far = (c.w * c.w + c.h * c.h - 2.0 * c.w * c.h * c.theta_deg.to_radians().cos()).sqrt();
@@ -699,11 +749,10 @@ fn touching_flat_pairs_give_finite_reciprocal_factors_in_0_1() {
     });
 }
 
-/// The same over the full range (aspect ratios up to 1e4 in every direction, 1°…179°). Fails
-/// today: see `long_strips_sharing_an_edge_are_classified_as_one_patch` and
-/// `folded_unequal_widths`.
+/// The same over the full range (aspect ratios up to 1e4 in every direction, 1°…179°). Failed
+/// before findings 1, 2 and 7 were fixed (`thin_or_folded_pairs_with_a_small_gap_…`,
+/// `folded_unequal_widths`, `thin_strips_folded_to_1_degree_as_single_patches`).
 #[test]
-#[ignore = "kernel bugs: adjacency misclassification of thin/folded pairs (F up to 3e4), fold grading for unequal widths"]
 fn touching_flat_pairs_of_any_aspect_give_finite_reciprocal_factors_in_0_1() {
     run_property("invariants, aspect up to 1e4", 256, full_range_strategy(), |(case, wide), stats| {
         if wide {
@@ -726,10 +775,10 @@ struct CurvedCase {
     motion: (f64, f64, f64, f64, [f64; 3]),
 }
 
-/// Gaps 0 or 1e-6 … 1e-3: below 1e-6 the C-41 reference itself loses digits (its X − 2 cancels:
-/// `curved_gap_reference_limit`).
+/// Gaps 0 or 1e-10 … 1e-3 (the C-41 reference is cancellation-free since the fix of
+/// `curved_gap_reference_limit`; it was limited to ≥ 1e-6 before).
 fn curved_strategy() -> impl Strategy<Value = CurvedCase> {
-    let gap = prop_oneof![1 => Just(0.0), 2 => (-6.0..=-3.0f64).prop_map(|e| 10f64.powf(e))];
+    let gap = prop_oneof![1 => Just(0.0), 2 => (-10.0..=-3.0f64).prop_map(|e| 10f64.powf(e))];
     (-0.5..=0.5f64, gap, prop_oneof![Just(4usize), Just(8usize)], motion_strategy())
         .prop_map(|(h, gap, sectors, motion)| CurvedCase { height: 10f64.powf(h), gap, sectors, motion })
 }
@@ -810,7 +859,7 @@ fn check_curved(case: &CurvedCase, stats: &mut Stats) -> Result<(), TestCaseErro
     prop_assert!(rr <= 1e-12, "reciprocity {ab:e} vs {ba:e}");
     let e = rel(f, reference);
     stats.see("disk → wall vs 1 − C-41", e);
-    prop_assert!(e <= 1e-6 + 2e-2 * case.gap, "disk → wall {f:.15e} vs {reference:.15e}: {e:.2e}");
+    prop_assert!(e <= 1e-6, "disk → wall {f:.15e} vs {reference:.15e}: {e:.2e}");
     let (x64, _) = disk_and_wall::<f64>(case, settings(6, 8)).map_err(fail)?;
     let (x32, y32) = disk_and_wall::<f32>(case, settings(6, 8)).map_err(fail)?;
     let r32 = rel(x32, x64);
@@ -829,7 +878,7 @@ fn check_curved(case: &CurvedCase, stats: &mut Stats) -> Result<(), TestCaseErro
     let rr = rel(ba, ab);
     stats.see("reciprocity (dome)", rr);
     prop_assert!(rr <= 1e-12, "reciprocity {ab:e} vs {ba:e}");
-    prop_assert!(f <= 1.0 + 1e-7 && e <= 1e-7 + 2e-2 * case.gap, "base → dome {f:.15e} vs {reference:.15e}");
+    prop_assert!(f <= 1.0 + 1e-7 && e <= 1e-7, "base → dome {f:.15e} vs {reference:.15e}");
     let (x64, _) = dome_and_base::<f64>(case, settings(6, 8)).map_err(fail)?;
     let (x32, _) = dome_and_base::<f32>(case, settings(6, 8)).map_err(fail)?;
     let r32 = rel(x32, x64);
@@ -844,8 +893,9 @@ fn curved_touching_pairs_against_closed_forms() {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Regression tests: what the properties and the fuzzer found (pdm-host/FUZZING.md). Those marked
-// `#[ignore]` reproduce open bugs: they assert the correct behaviour and fail today.
+// Regression tests: what the properties and the fuzzer found (pdm-host/FUZZING.md, "Findings"),
+// all fixed; an open bug's reproducer would be marked `#[ignore]` and assert the correct
+// behaviour. `error_versus_order` (ignored) only prints the measurements.
 
 fn plain_case(theta_deg: f64, l: f64, w: f64, h: f64, gap: f64) -> EdgeCase {
     EdgeCase { theta_deg, l, w, h, gap, motion: (1.0, 0.0, 0.0, 0.0, [0.0; 3]), variant_floor: 0, variant_flap: 0 }
@@ -861,7 +911,7 @@ fn single_patch(case: &EdgeCase, order: usize) -> (Adjacency, f64, f64) {
 }
 
 #[test]
-#[ignore = "kernel bug: near contact (2 % of the largest diagonal) matches the far corners of thin or folded pairs → Identical → Separate"]
+// Fixed: near contact is relative to the shortest edge and matches the single best edge.
 fn thin_or_folded_pairs_with_a_small_gap_are_classified_as_one_patch() {
     // With exact contact these are SharedEdge (fixed in 8d729dc); lift the flap by a gap above
     // the tight tolerance and classify_near falls back to the 2 % tolerance, which also matches
@@ -879,12 +929,20 @@ fn thin_or_folded_pairs_with_a_small_gap_are_classified_as_one_patch() {
 }
 
 #[test]
-#[ignore = "kernel accuracy: one touching patch pair of aspect ≳ 16 is not resolved by the transform, and F > 1 is returned as Ok"]
+// Fixed: the transforms scale their variables by the side lengths (any aspect ratio).
 fn thin_strips_folded_to_1_degree_as_single_patches() {
-    // 23.8 × 1 strips folded to 1° (exact contact): F = 1.057 at order 8 (contour 0.9909).
+    // 23.8 × 1 strips folded to 1° (exact contact): F = 1.057 at order 8 before (contour 0.9909).
     let (adjacency, f, reference) = single_patch(&plain_case(1.0, 23.814866167165576, 1.0, 1.0, 0.0), 8);
     println!("{adjacency:?} F = {f} (contour {reference})");
     assert!((0.0..=1.0).contains(&f), "F = {f}");
+    assert!(rel(f, reference) < 1e-6, "F = {f} vs {reference}");
+    // Aspect 1 : 16 at 30° (4e-2 off at order 12 before) and a flap 1e-4 as high as the floor
+    // is wide (≈ 100 % off before), at order 12.
+    for case in [plain_case(30.0, 1.0, 16.0, 16.0, 0.0), plain_case(90.0, 1.0, 1.0, 1e-4, 0.0)] {
+        let (_, f, reference) = single_patch(&case, 12);
+        println!("l {} w {} h {}: F = {f} (contour {reference}): {:.1e}", case.l, case.w, case.h, rel(f, reference));
+        assert!(rel(f, reference) < 1e-10, "F = {f} vs {reference}");
+    }
 }
 
 #[test]
@@ -897,7 +955,7 @@ fn unit_squares_folded_to_1_degree_share_an_edge() {
 }
 
 #[test]
-#[ignore = "kernel bug: the fold grading assumes equal widths (peak at η_a = η_b, physically at w·η_a = h·η_b)"]
+// Fixed: the variables are scaled by the widths, so the peak is at equal scaled distances.
 fn folded_unequal_widths() {
     // Floor 1 × 2, flap 1 × 1 at 1° and 3°: relative errors 1.3 and 0.069 at order 12, 0.83 and
     // 0.23 at order 16, not converging; 1.1 : 1 at 1°: 1.6e-2 at order 12.
@@ -909,10 +967,12 @@ fn folded_unequal_widths() {
 }
 
 #[test]
-#[ignore = "kernel accuracy: nearly folded and nearly touching — error ∝ gap, not decreasing with the order"]
+// Fixed: the ratio grading follows the peak (the closest point of the other patch's line), and
+// ζ is also graded from the gap upwards.
 fn nearly_folded_and_nearly_touching() {
     // Unit squares at 2°, flap lifted by 1e-3 along its plane: 4.5e-6 (order 12), 6.8e-6 (16),
-    // 1.6e-5 (20), 5.8e-6 (24), 2.1e-6 (32); ≈ 1.6e-2 × gap. Without the gap: 1e-16 by order 16.
+    // 1.6e-5 (20), 5.8e-6 (24), 2.1e-6 (32) before (≈ 1.6e-2 × gap); 1.9e-10 at 20 now.
+    // Without the gap: 1e-16 by order 16.
     let (adjacency, f, reference) = single_patch(&plain_case(2.0, 1.0, 1.0, 1.0, 1e-3), 20);
     println!("{adjacency:?} F = {f} (contour {reference}): {:.1e}", rel(f, reference));
     assert!(rel(f, reference) < 1e-9, "F = {f} vs {reference}");
@@ -940,7 +1000,8 @@ fn polar_cells_of_a_sphere_are_neighbours_not_one_patch() {
 }
 
 #[test]
-#[ignore = "kernel bug: f32 cells far from the origin (coordinates ≈ 2e4 cell sizes) are classified Identical → Ok(0)"]
+// Fixed: Identical needs the normals to agree, and a contact whose fold is not resolved by the
+// working precision is refused (Err(Degenerate)).
 fn f32_long_grid_cells_at_a_small_dihedral_angle_are_classified_identical() {
     let case = EdgeCase {
         theta_deg: 2.0163952535064036,
@@ -990,7 +1051,7 @@ fn fuzz_caller_supplied_subnormal_gap_is_slow() {
 }
 
 #[test]
-#[ignore = "reference bug (pdm_host::reference::closed_form::coaxial_disks): X − 2 cancels for h ≪ r"]
+// Fixed: coaxial_disks factors X² − 4(R₂/R₁)² with X − 2R₂/R₁ = (1 + (R₁ − R₂)²)/R₁².
 fn curved_gap_reference_limit() {
     // Equal coaxial disks: F = 1 − h/R + h²/(2R²) − …; at h = 1e-8 R the closed form returns 1.
     // (X² − 4(R₂/R₁)² = (X − 2R₂/R₁)(X + 2R₂/R₁) with X − 2R₂/R₁ = (1 + (R₁ − R₂)²)/R₁² is exact.)
@@ -1003,14 +1064,15 @@ fn curved_gap_reference_limit() {
 #[test]
 fn long_edge_folded_to_2_degrees_cut_into_cells() {
     // The edge property's shrunk worst case: 504 cells along the edge at 2°. The vertex
-    // neighbours converge algebraically (no fold grading in the vertex transform).
+    // neighbours converged algebraically before the vertex transform graded towards the peak
+    // (1.6e-6 at order 20; 2.0e-14 since).
     let case = EdgeCase { variant_flap: 2, ..plain_case(2.0, 503.9195016890531, 1.0, 1.0, 0.0) };
     let (floor, flap) = case.build::<f64>().unwrap();
     let f = edge_sum(&floor, &flap, case.cells(), 20).unwrap() / (case.l * case.w);
     let (pf, pp) = case.polygons();
     let reference = contour::polygon_form_factor(&pf, &pp);
     println!("F = {f} (contour {reference}): {:.1e}", rel(f, reference));
-    assert!(rel(f, reference) < 5e-6);
+    assert!(rel(f, reference) < 1e-12, "{f} vs {reference}");
 }
 
 #[test]
@@ -1032,5 +1094,48 @@ fn fuzz_whole_sphere_and_a_parallelogram_along_its_axis() {
         ] {
             assert!(x.map_or(true, |x| x.is_finite() && x >= 0.0), "{x:?}");
         }
+    }
+}
+
+/// Error against the contour reference versus the singular order for the single-pair cases of
+/// the findings (numbers in FUZZING.md). Not a check: prints a table.
+/// `cargo test --release -p pdm-host --test fuzz_singular -- --ignored --nocapture error_versus_order`
+#[test]
+#[ignore = "measurement, prints a table"]
+fn error_versus_order() {
+    let cases: [(&str, EdgeCase); 10] = [
+        ("unit squares at 1°", plain_case(1.0, 1.0, 1.0, 1.0, 0.0)),
+        ("100 × 1 at 90°, gap 1e-5", plain_case(90.0, 100.0, 1.0, 1.0, 1e-5)),
+        ("unit squares at 1°, gap 1e-6", plain_case(1.0, 1.0, 1.0, 1.0, 1e-6)),
+        ("23.8 × 1 at 1°", plain_case(1.0, 23.814866167165576, 1.0, 1.0, 0.0)),
+        ("1 × 16 at 30° (l : w = 1 : 16)", plain_case(30.0, 1.0, 16.0, 16.0, 0.0)),
+        ("floor 1 × 1, flap 1e-4 at 90°", plain_case(90.0, 1.0, 1.0, 1e-4, 0.0)),
+        ("floor 1 × 2, flap 1 × 1 at 1°", plain_case(1.0, 1.0, 2.0, 1.0, 0.0)),
+        ("floor 1 × 2, flap 1 × 1 at 3°", plain_case(3.0, 1.0, 2.0, 1.0, 0.0)),
+        ("floor 1 × 1.1, flap 1 × 1 at 1°", plain_case(1.0, 1.0, 1.1, 1.0, 0.0)),
+        ("unit squares at 2°, gap 1e-3", plain_case(2.0, 1.0, 1.0, 1.0, 1e-3)),
+    ];
+    for (name, case) in cases {
+        let mut line = format!("{name:34}");
+        for order in [8, 12, 16, 20, 24] {
+            let start = std::time::Instant::now();
+            let (_, f, reference) = single_patch(&case, order);
+            line += &format!(" {order}: {:.1e} ({:.2} s)", rel(f, reference), start.elapsed().as_secs_f64());
+        }
+        println!("{line}");
+    }
+    // Cells along an edge folded to 2° and 1° (finding 5: the vertex neighbours).
+    for deg in [2.0, 1.0] {
+        let case = EdgeCase { variant_flap: 2, ..plain_case(deg, 503.9195016890531, 1.0, 1.0, 0.0) };
+        let (floor, flap) = case.build::<f64>().unwrap();
+        let (pf, pp) = case.polygons();
+        let reference = contour::polygon_form_factor(&pf, &pp);
+        let mut line = format!("{:34}", format!("504 unit cells at {deg}°"));
+        for order in [8, 12, 16, 20, 24] {
+            let start = std::time::Instant::now();
+            let f = edge_sum(&floor, &flap, case.cells(), order).unwrap() / (case.l * case.w);
+            line += &format!(" {order}: {:.1e} ({:.2} s)", rel(f, reference), start.elapsed().as_secs_f64());
+        }
+        println!("{line}");
     }
 }

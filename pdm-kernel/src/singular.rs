@@ -16,10 +16,25 @@
 //! tensor Gauss rule converges exponentially: machine precision for perpendicular unit squares
 //! by order ≈ 12.
 //!
+//! **Any aspect ratio.** The variables are scaled by the physical side lengths (edge length L,
+//! widths w_a, w_b; at a vertex the four sides) over the shortest side r₀, so the box of scaled
+//! variables is [0, L/r₀] × [0, w_a/r₀] × [0, w_b/r₀]: the cube [0, 1]³ near the edge is
+//! physically a cube and gets the pyramids above; the rest of each pyramid (the box cuts it
+//! where ζ exceeds another side's extent; the ratios then run to min(1, extent/ζ)) is covered by
+//! shells ζ ∈ [1, 4], [4, 16], … with breaks at the other extents. This is the cut of a long
+//! pair into near-square sub-pairs done inside the transform, allocation-free, at O(log aspect)
+//! extra shells (fuzz finding 7).
+//!
 //! **Nearly folded pairs.** When the dihedral angle θ between the two patches is small (their
-//! normals at the edge nearly opposite), the kernel inside two of the pyramids peaks in a corner
-//! with width ≈ θ; those pyramids' inner variables are then split geometrically towards that
-//! corner (θ, 4θ, 16θ, …), which keeps the convergence exponential down to θ ≈ 1°.
+//! normals at the edge nearly opposite), the kernel inside two of the pyramids peaks along the
+//! line where the other patch comes closest (equal scaled distances from the edge; 1 − g/ζ with a
+//! gap g; the far side of the narrower patch beyond its width) with width ≈ θ. Per ζ node that
+//! closest point is found on the other patch's coordinate line (golden section) and the ratio
+//! variables are split geometrically around it and towards u = 0 (widths: closest distance /
+//! line length), and ζ is also split upwards from the narrower side's extent and from the gap:
+//! exponential convergence down to θ ≈ 1°, with or without a gap (findings 2 and 3). Vertex
+//! pairs do the same when one patch's edge from the vertex comes close to one of the other's
+//! (cells along a nearly folded edge, finding 5).
 //!
 //! **Shared vertex.** Both patches are mapped so that the common corner is (0, 0); the 4-cube is
 //! split into four pyramids by its largest coordinate, Jacobian ζ³ (the singularity is 1/ζ²).
@@ -28,10 +43,15 @@
 //! handled by the same transforms with the ζ-interval split geometrically down to the gap, so the
 //! near-singular peak is resolved (error bounded independently of the gap).
 //!
-//! Adjacency is detected from the geometry ([`classify`]): corners closer than
-//! `ADJACENCY_TOLERANCE × patch size + 16 ε × coordinate magnitude` coincide; an edge is shared
-//! when both its corners coincide and its quarter, mid and three-quarter points do too (so the
-//! two parameterisations agree along it, as the transform requires).
+//! Adjacency is detected from the geometry ([`classify`], [`classify_near`]): one to one, the
+//! single best match — the edge of A and edge of B (either direction) whose end points are
+//! closest, else the closest pair of corners — within `ADJACENCY_TOLERANCE × patch size +
+//! 16 ε × coordinate magnitude` (exact contact) or [`NEAR_CONTACT`] × the shortest edge (near
+//! contact; then also clearly the closest pair); an edge is shared when its quarter, mid and
+//! three-quarter points coincide too (so the two parameterisations agree along it, as the
+//! transform requires). `Identical` needs all four corners, the centres and the normals there to
+//! agree. A contact the working precision cannot resolve (the rounding band not small against
+//! the shortest edge × the fold angle) is refused with `Err(Degenerate)` (finding 6).
 
 use crate::error::PdmError;
 use crate::gauss::GaussRule;
@@ -152,19 +172,27 @@ where
     SA: Surface<T> + ?Sized,
     SB: Surface<T> + ?Sized,
 {
-    contact(a, b, adjacency_tolerance::<T>()).0
+    contact(a, b, false).0
 }
 
 /// Relative gap below which a pair that does not touch is still integrated with the touching
-/// transforms (graded towards the gap): 2 % of the patch size. The transforms are exact changes
-/// of variables for any pair; they pay off when the near-singularity sits at the pyramids' apex,
-/// i.e. when the matched edge or corner is where the patches come closest — true for small gaps,
-/// not for e.g. two parallel patches facing each other at a distance comparable to their size.
+/// transforms (graded towards the gap): 2 % of the shortest edge of the two patches. The
+/// transforms are exact changes of variables for any pair; they pay off when the near-singularity
+/// sits at the pyramids' apex, i.e. when the matched edge or corner is where the patches come
+/// closest — so a near match is also required to be at most half as far apart as any other pair
+/// of corners (not e.g. two parallel patches facing each other at a small distance).
 pub const NEAR_CONTACT: f64 = 0.02;
 
-/// Like [`classify`], but corners closer than [`NEAR_CONTACT`] × size also count as shared;
-/// returns the adjacency and the gap (largest distance between matched points, relative to the
-/// patch size; 0 up to rounding for patches that truly touch).
+/// Like [`classify`], but corners closer than [`NEAR_CONTACT`] × the shortest edge also count as
+/// shared; returns the adjacency and the gap (largest distance between matched points, relative
+/// to the patch size — the larger of the two patches' diagonals; 0 up to rounding for patches
+/// that truly touch).
+///
+/// A gap of `T::MAX` (finite, so callers that check the gap see a number) means the contact
+/// cannot be resolved in the working precision (the rounding of the coordinates, 16 ε × their
+/// magnitude, is not small against the shortest edge × the fold angle: f32 cells far from the
+/// origin); [`touching_exchange`] then refuses the pair with `Err(Degenerate)` rather than
+/// return a silently wrong value.
 #[must_use]
 pub fn classify_near<T, SA, SB>(a: &Patch<'_, T, SA>, b: &Patch<'_, T, SB>) -> (Adjacency, T)
 where
@@ -174,25 +202,69 @@ where
 {
     // A gap at the level of rounding is no gap: grading for it would only cost time.
     let rounding = T::from_f64(64.0) * T::EPSILON;
-    let (exact, exact_gap) = contact(a, b, adjacency_tolerance::<T>());
+    let (exact, exact_gap) = contact(a, b, false);
     if exact != Adjacency::Separate {
-        // Touching within the tight tolerance (or the same patch): the near tolerance could
-        // only blur it (a 1° fold brings the far corners within it too). A gap below the
-        // tolerance but above rounding is still graded for.
+        // Touching within the tight tolerance (or the same patch). A gap below the tolerance but
+        // above rounding is still graded for.
         let gap = if exact == Adjacency::Identical || !(exact_gap > rounding) { T::ZERO } else { exact_gap };
         return (exact, gap);
     }
-    let (adjacency, gap) = contact(a, b, T::from_f64(NEAR_CONTACT));
+    let (adjacency, gap) = contact(a, b, true);
     if adjacency == Adjacency::Identical {
-        // Nearly coincident but not the same patch (e.g. two close parallel patches): no
-        // transform applies.
+        // Nearly coincident but not the same patch: no transform applies.
         return (Adjacency::Separate, T::ZERO);
     }
     (adjacency, if gap > rounding { gap } else { T::ZERO })
 }
 
-/// Adjacency at relative tolerance `rel_tol`, and the relative gap of the matched points.
-fn contact<T, SA, SB>(a: &Patch<'_, T, SA>, b: &Patch<'_, T, SB>, rel_tol: T) -> (Adjacency, T)
+/// Largest corner-to-corner distance of a patch.
+fn diameter<T: Real>(c: &[Vec3<T>; 4]) -> T {
+    let mut m = T::ZERO;
+    for p in c {
+        for q in c {
+            m = m.max((*p - *q).norm());
+        }
+    }
+    m
+}
+
+/// The four edges of a patch as pairs of corner numbers (corner k ↦ (k & 1, k >> 1)).
+const EDGES: [(usize, usize); 4] = [(0, 1), (2, 3), (0, 2), (1, 3)];
+
+/// Shortest edge of a patch longer than `collapsed` (a sphere's polar cell has an edge of length
+/// 0); `T::MAX` if there is none.
+fn shortest_edge<T: Real>(c: &[Vec3<T>; 4], collapsed: T) -> T {
+    let mut m = T::MAX;
+    for (i, j) in EDGES {
+        if let (Some(p), Some(q)) = (c.get(i), c.get(j)) {
+            let l = (*p - *q).norm();
+            if l > collapsed {
+                m = m.min(l);
+            }
+        }
+    }
+    m
+}
+
+/// Fraction of the shortest edge (times the fold parameter, for a nearly folded edge pair) that
+/// the rounding band of the coordinates (16 ε × their magnitude) may reach before a contact is
+/// refused as unresolvable (see [`classify_near`]). A pair folded to θ moves by ≈ θ × its size
+/// when θ changes by 100 %, so rounding must be small against θ × size, not just the size. At
+/// 1/4 (the first choice), f32 pairs at 1–1.5° with coordinates 600–800 times their shortest
+/// edge still returned F = 1.003 (seed 7 of the invariants property); at 1/32 they are refused
+/// and the f32 properties near the origin (coordinates ≤ ≈ 100 shortest edges) are not affected.
+const RESOLUTION: f64 = 1.0 / 32.0;
+
+/// Adjacency at the tight tolerance (`near` = false: [`adjacency_tolerance`] × patch size) or the
+/// near-contact one, and the relative gap of the matched points (`T::MAX`: unresolvable).
+///
+/// Matching is one to one and picks the single best candidate: the edge of A and edge of B
+/// (either direction) whose end points are closest (the larger of the two distances), else the
+/// closest pair of corners. Far corners that also come close (thin strips, a pair folded to a
+/// small angle) cannot add matches. `Identical` needs all four corners matched one to one, the
+/// centres to coincide and the normals there to point the same way (a pair folded flat onto
+/// itself has opposite normals).
+fn contact<T, SA, SB>(a: &Patch<'_, T, SA>, b: &Patch<'_, T, SB>, near: bool) -> (Adjacency, T)
 where
     T: Real,
     SA: Surface<T> + ?Sized,
@@ -200,62 +272,112 @@ where
 {
     let ca = corner_points(a);
     let cb = corner_points(b);
-    let size = |c: &[Vec3<T>; 4]| {
-        let mut m = T::ZERO;
-        for p in c {
-            for q in c {
-                m = m.max((*p - *q).norm());
-            }
-        }
-        m
-    };
     let magnitude = ca.iter().chain(cb.iter()).fold(T::ZERO, |m, p| m.max(p.max_abs()));
-    let scale = size(&ca).max(size(&cb));
-    let tol = rel_tol * scale + T::from_f64(16.0) * T::EPSILON * magnitude;
-    let same = |p: Vec3<T>, q: Vec3<T>| (p - q).norm() <= tol;
-    let gap_of = |p: Vec3<T>, q: Vec3<T>| if scale > T::ZERO { (p - q).norm() / scale } else { T::ZERO };
-    // matches[i] = Some(j) if corner i of A coincides with corner j of B.
-    // One-to-one: a corner of B is matched at most once (a patch with a collapsed edge — a
-    // sphere's polar cell, a cone's apex — has two equal corners).
-    let mut matches = [None; 4];
+    let band = T::from_f64(16.0) * T::EPSILON * magnitude;
+    let scale = diameter(&ca).max(diameter(&cb));
+    let tight = adjacency_tolerance::<T>() * scale + band;
+    let shortest = shortest_edge(&ca, tight).min(shortest_edge(&cb, tight));
+    let tol = if near {
+        if shortest < T::MAX {
+            T::from_f64(NEAR_CONTACT) * shortest + band
+        } else {
+            band
+        }
+    } else {
+        tight
+    };
+    let dist = |i: usize, j: usize| match (ca.get(i), cb.get(j)) {
+        (Some(p), Some(q)) => (*p - *q).norm(),
+        _ => T::MAX,
+    };
+    // A distance within the rounding band of the coordinates is no gap: grading the transform
+    // towards it would place nodes where e = p_b − p_a is rounding noise (f64 cells 7e4 cell
+    // sizes from the origin were 1e-8…1e-7 off that way).
+    let gap_of = |p: Vec3<T>, q: Vec3<T>| {
+        let d = (p - q).norm();
+        if scale > T::ZERO && d > band {
+            d / scale
+        } else {
+            T::ZERO
+        }
+    };
+    // The geometry is resolved when the rounding band is small against every edge (times the
+    // fold parameter for an edge pair); otherwise a contact found is reported with the gap `T::MAX`
+    // (refused by touching_exchange).
+    let flag = |adjacency: Adjacency, gap: T, sensitivity: T| {
+        let resolved = shortest < T::MAX && band <= T::from_f64(RESOLUTION) * shortest * sensitivity.min(T::ONE);
+        if resolved {
+            (adjacency, gap)
+        } else {
+            (adjacency, T::MAX)
+        }
+    };
+
+    // Identical: a one-to-one match of all four corners, coinciding centres and normals.
     let mut used = [false; 4];
     let mut count = 0;
-    for (i, p) in ca.iter().enumerate() {
-        for (j, q) in cb.iter().enumerate() {
+    for i in 0..4 {
+        for j in 0..4 {
             let free = used.get(j).is_some_and(|u| !*u);
-            if free && same(*p, *q) {
-                if let (Some(m), Some(u)) = (matches.get_mut(i), used.get_mut(j)) {
-                    if m.is_none() {
-                        *m = Some(j);
-                        *u = true;
-                        count += 1;
-                    }
+            if free && dist(i, j) <= tol {
+                if let Some(u) = used.get_mut(j) {
+                    *u = true;
+                    count += 1;
+                }
+                break;
+            }
+        }
+    }
+    if count == 4 {
+        let (ta, sa) = centre_of(a);
+        let (tb, sb) = centre_of(b);
+        let (pa, na) = a.surface().point_and_normal(ta, sa);
+        let (pb, nb) = b.surface().point_and_normal(tb, sb);
+        if (pa - pb).norm() <= tol && na.dot(nb) > T::ZERO {
+            return (Adjacency::Identical, T::ZERO);
+        }
+    }
+
+    // Best edge: A's edge (i1, i2) against B's edge (j1, j2) in either direction.
+    let mut best: Option<(T, usize, usize, usize, usize)> = None;
+    for (i1, i2) in EDGES {
+        if dist_within(&ca, i1, i2) <= tight {
+            continue; // a collapsed edge
+        }
+        for (k1, k2) in EDGES {
+            if dist_within(&cb, k1, k2) <= tight {
+                continue;
+            }
+            for (j1, j2) in [(k1, k2), (k2, k1)] {
+                let cost = dist(i1, j1).max(dist(i2, j2));
+                if best.is_none_or(|(c, ..)| cost < c) {
+                    best = Some((cost, i1, i2, j1, j2));
                 }
             }
         }
     }
-    match count {
-        0 => (Adjacency::Separate, T::ZERO),
-        1 => {
-            let Some((i, j)) = matches.iter().enumerate().find_map(|(i, m)| m.map(|j| (i, j))) else {
-                return (Adjacency::Separate, T::ZERO);
-            };
-            let gap = match (ca.get(i), cb.get(j)) {
-                (Some(p), Some(q)) => gap_of(*p, *q),
-                _ => T::ZERO,
-            };
-            // Any local orientation with (0,0) at the shared corner.
-            match (SquareMap::from_corners(i, i ^ 1), SquareMap::from_corners(j, j ^ 1)) {
-                (Some(ma), Some(mb)) => (Adjacency::SharedVertex { a: ma, b: mb }, gap),
-                _ => (Adjacency::Separate, T::ZERO),
+    // In near contact the match must be clearly where the patches come closest: the nearest
+    // other pair of corners at least twice as far apart.
+    let clearly_closest = |gap_abs: T, skip: &[(usize, usize)]| {
+        if !near {
+            return true;
+        }
+        let mut other = T::MAX;
+        for i in 0..4 {
+            for j in 0..4 {
+                if !skip.contains(&(i, j)) {
+                    other = other.min(dist(i, j));
+                }
             }
         }
-        2 => {
-            let mut it = matches.iter().enumerate().filter_map(|(i, m)| m.map(|j| (i, j)));
-            let (Some((i1, j1)), Some((i2, j2))) = (it.next(), it.next()) else {
+        gap_abs * T::TWO <= other
+    };
+    if let Some((cost, i1, i2, j1, j2)) = best {
+        if cost <= tol {
+            if !clearly_closest(cost, &[(i1, j1), (i2, j2)]) {
                 return (Adjacency::Separate, T::ZERO);
-            };
-            match (SquareMap::from_corners(i1, i2), SquareMap::from_corners(j1, j2)) {
+            }
+            return match (SquareMap::from_corners(i1, i2), SquareMap::from_corners(j1, j2)) {
                 (Some(ma), Some(mb)) => {
                     let la = Local { patch: a, map: ma };
                     let lb = Local { patch: b, map: mb };
@@ -264,32 +386,53 @@ where
                     for f in [0.0, 0.25, 0.5, 0.75, 1.0] {
                         let f = T::from_f64(f);
                         let (p, q) = (la.eval(f, T::ZERO).0, lb.eval(f, T::ZERO).0);
-                        agree = agree && same(p, q);
+                        agree = agree && (p - q).norm() <= tol;
                         gap = gap.max(gap_of(p, q));
                     }
                     if agree {
-                        (Adjacency::SharedEdge { a: ma, b: mb }, gap)
+                        flag(Adjacency::SharedEdge { a: ma, b: mb }, gap, fold_angle(&la, &lb))
                     } else {
-                        // Two corners in common that are not one edge of both, or an edge
-                        // parameterised differently: the transform does not apply.
+                        // Two corners in common but the edge parameterised differently (or
+                        // not one edge of both): the transform does not apply.
                         (Adjacency::Separate, T::ZERO)
                     }
                 }
                 _ => (Adjacency::Separate, T::ZERO),
+            };
+        }
+    }
+
+    // Best vertex.
+    let mut best: Option<(T, usize, usize)> = None;
+    for i in 0..4 {
+        for j in 0..4 {
+            let d = dist(i, j);
+            if best.is_none_or(|(c, ..)| d < c) {
+                best = Some((d, i, j));
             }
         }
-        _ => {
-            // Three or four corners in common: the same patch only if the centres coincide too
-            // (two polar cells of a sphere share all their corners but not their centres).
-            let (ta, sa) = centre_of(a);
-            let (tb, sb) = centre_of(b);
-            if count == 4 && same(a.surface().point(ta, sa), b.surface().point(tb, sb)) {
-                (Adjacency::Identical, T::ZERO)
-            } else {
-                // Several shared edges (or an ambiguous match): no single transform applies.
-                (Adjacency::Separate, T::ZERO)
+    }
+    match best {
+        Some((d, i, j)) if d <= tol && clearly_closest(d, &[(i, j)]) => {
+            let gap = match (ca.get(i), cb.get(j)) {
+                (Some(p), Some(q)) => gap_of(*p, *q),
+                _ => T::ZERO,
+            };
+            // Any local orientation with (0,0) at the shared corner.
+            match (SquareMap::from_corners(i, i ^ 1), SquareMap::from_corners(j, j ^ 1)) {
+                (Some(ma), Some(mb)) => flag(Adjacency::SharedVertex { a: ma, b: mb }, gap, T::ONE),
+                _ => (Adjacency::Separate, T::ZERO),
             }
         }
+        _ => (Adjacency::Separate, T::ZERO),
+    }
+}
+
+/// Distance between corners `i` and `j` of one patch.
+fn dist_within<T: Real>(c: &[Vec3<T>; 4], i: usize, j: usize) -> T {
+    match (c.get(i), c.get(j)) {
+        (Some(p), Some(q)) => (*p - *q).norm(),
+        _ => T::ZERO,
     }
 }
 
@@ -303,12 +446,20 @@ fn unit_points<T: Real>(rule: &GaussRule<T>) -> impl Iterator<Item = (T, T)> + '
 /// transforms in the module docs with the `order`-point rule on each of the four variables.
 /// `gap` is the relative gap from [`classify_near`] (0 for patches that truly touch): for a
 /// positive gap the radial variable ζ is split geometrically at gap·4ᵏ so the near-singular
-/// peak is resolved.
+/// peak is resolved. A gap of `T::MAX` (contact not resolvable in the working precision, see
+/// [`classify_near`]) is refused with `Err(Degenerate)`.
 /// `Separate` pairs are refused (`Err(Degenerate)`) — use the plain sum for them; `Identical`
 /// pairs too (a patch's own F_ii needs [`crate::self_form_factor`]).
 ///
-/// Cost: 6·order⁴ (edge) or 4·order⁴ (vertex) integrand evaluations; each evaluates both surfaces
-/// (no precomputation is possible: the sample points depend on all four variables).
+/// Patches of any aspect ratio: the variables are scaled by the physical lengths of the sides
+/// (edge length and the two widths; the four sides at a vertex) so that the cube split into
+/// pyramids is physically a cube of the shortest side, and the rest of each pyramid is covered
+/// by shells ζ ∈ [1, 4], [4, 16], … (see `edge_sum`).
+///
+/// Cost: 6·order⁴ (edge) or 4·order⁴ (vertex) integrand evaluations for near-square patches
+/// that truly touch, times the number of ζ-shells (≈ log₄ of the aspect ratio and of 1/gap);
+/// each evaluates both surfaces (no precomputation is possible: the sample points depend on all
+/// four variables).
 pub fn touching_exchange<T, SA, SB, O>(
     a: &Patch<'_, T, SA>,
     b: &Patch<'_, T, SB>,
@@ -324,18 +475,35 @@ where
     O: Occluder<T> + ?Sized,
 {
     let rule = GaussRule::<T>::new(order)?;
+    if gap >= T::MAX {
+        return Err(PdmError::Degenerate);
+    }
     // A gap at the level of rounding is no gap (and a subnormal one would make hundreds of
     // graded intervals).
     let gap = if gap > T::from_f64(64.0) * T::EPSILON && gap.is_finite() { gap } else { T::ZERO };
+    let scale = diameter(&corner_points(a)).max(diameter(&corner_points(b)));
     let sum = match adjacency {
         Adjacency::SharedEdge { a: ma, b: mb } => {
             let (la, lb) = (Local { patch: a, map: ma }, Local { patch: b, map: mb });
             let fold = fold_angle(&la, &lb);
-            graded(gap, |z0, z1| edge_sum(&la, &lb, &rule, occluders, z0, z1, fold))
+            let half = T::HALF;
+            let lengths = [
+                line_length(&la, (T::ZERO, T::ZERO), (T::ONE, T::ZERO)),
+                line_length(&la, (half, T::ZERO), (half, T::ONE)),
+                line_length(&lb, (half, T::ZERO), (half, T::ONE)),
+            ];
+            let (ext, r0) = extents(lengths);
+            let g = if r0 > T::ZERO { gap * scale / r0 } else { gap };
+            edge_sum(&la, &lb, &rule, occluders, ext, at(&lengths, 0), g, fold)
         }
         Adjacency::SharedVertex { a: ma, b: mb } => {
             let (la, lb) = (Local { patch: a, map: ma }, Local { patch: b, map: mb });
-            graded(gap, |z0, z1| vertex_sum(&la, &lb, &rule, occluders, z0, z1))
+            let (o, x, y) = ((T::ZERO, T::ZERO), (T::ONE, T::ZERO), (T::ZERO, T::ONE));
+            let lengths =
+                [line_length(&la, o, x), line_length(&la, o, y), line_length(&lb, o, x), line_length(&lb, o, y)];
+            let (ext, r0) = extents(lengths);
+            let g = if r0 > T::ZERO { gap * scale / r0 } else { gap };
+            vertex_sum(&la, &lb, &rule, occluders, ext, g)
         }
         Adjacency::Separate | Adjacency::Identical => return Err(PdmError::Degenerate),
     };
@@ -346,22 +514,72 @@ where
     Ok(value)
 }
 
-/// Σ over ζ-intervals [0, g], [g, 4g], [4g, 16g], … up to 1 (or just [0, 1] when g = 0 or g is
-/// not small).
-fn graded<T: Real>(gap: T, mut integral: impl FnMut(T, T) -> T) -> T {
-    if !(gap > T::ZERO) || !(gap < T::from_f64(0.25)) {
-        return integral(T::ZERO, T::ONE);
-    }
-    let four = T::from_f64(4.0);
-    let mut lo = T::ZERO;
-    let mut hi = gap;
+/// Length of the local coordinate line from `p` to `q` (a 4-segment polyline).
+fn line_length<T: Real, S: Surface<T> + ?Sized>(l: &Local<'_, '_, T, S>, p: (T, T), q: (T, T)) -> T {
+    let quarter = T::from_f64(0.25);
+    let mut prev = l.eval(p.0, p.1).0;
     let mut total = T::ZERO;
-    while lo < T::ONE {
-        total += integral(lo, hi);
-        lo = hi;
-        hi = (hi * four).min(T::ONE);
+    for k in 1..=4u8 {
+        let f = T::from_f64(f64::from(k)) * quarter;
+        let next = l.eval(p.0 + (q.0 - p.0) * f, p.1 + (q.1 - p.1) * f).0;
+        total += (next - prev).norm();
+        prev = next;
     }
     total
+}
+
+/// Largest scaled extent: aspect ratios beyond this are integrated as if they were this (bounds
+/// the number of shells; 2⁴⁰ ≈ 1.1e12).
+const MAX_EXTENT: f64 = 1_099_511_627_776.0;
+
+/// The extents of the scaled variables (side length / shortest side, in [1, MAX_EXTENT]) and the
+/// shortest side; all 1 (and 0) if the lengths are not usable.
+fn extents<T: Real, const N: usize>(lengths: [T; N]) -> ([T; N], T) {
+    let r0 = lengths.iter().fold(T::MAX, |m, l| m.min(*l));
+    if !(r0 > T::ZERO && r0.is_finite() && lengths.iter().all(|l| l.is_finite())) {
+        return ([T::ONE; N], T::ZERO);
+    }
+    let max = T::from_f64(MAX_EXTENT);
+    (lengths.map(|l| (l / r0).max(T::ONE).min(max)), r0)
+}
+
+/// Most ζ-shells of one pyramid; the last one reaches the end whatever its length.
+const MAX_SHELLS: usize = 128;
+
+/// Calls `f(lo, hi)` for the ζ-shells of a pyramid of extent `end` (≥ 1): [0, g], [g, 4g], …
+/// up to 1 (just [0, 1] when g = 0 or g is not small), then [1, 4], [4, 16], … up to `end`,
+/// with a break at each of `breaks` (the other extents: where a ratio's upper limit
+/// min(1, extent/ζ) has its kink).
+fn for_each_shell<T: Real>(gap: T, end: T, breaks: &[T], mut f: impl FnMut(T, T)) {
+    let four = T::from_f64(4.0);
+    let mut lo = T::ZERO;
+    let mut hi = if gap > T::ZERO && gap < T::from_f64(0.25) { gap } else { T::ONE.min(end) };
+    for shell in 0..MAX_SHELLS {
+        if shell + 1 == MAX_SHELLS {
+            hi = end;
+        }
+        f(lo, hi);
+        if !(hi < end) {
+            return;
+        }
+        lo = hi;
+        let mut next = hi * four;
+        if lo < T::ONE {
+            next = next.min(T::ONE);
+        }
+        for b in breaks {
+            if *b > lo && *b < next {
+                next = *b;
+            }
+        }
+        hi = next.min(end);
+    }
+}
+
+/// Component `k` of a small array (0 if out of range; never happens).
+#[inline(always)]
+fn at<T: Real, const N: usize>(v: &[T; N], k: usize) -> T {
+    v.get(k).copied().unwrap_or(T::ZERO)
 }
 
 /// The kernel (n_a·e)(−n_b·e)/L⁴ with unnormalised (Jacobian-scaled) normals, zero where the
@@ -379,13 +597,15 @@ fn kernel<T: Real, O: Occluder<T> + ?Sized>(pa: Vec3<T>, na: Vec3<T>, pb: Vec3<T
     (ca * inv) * (cb * inv)
 }
 
+#[allow(clippy::too_many_arguments)]
 fn edge_sum<T, SA, SB, O>(
     a: &Local<'_, '_, T, SA>,
     b: &Local<'_, '_, T, SB>,
     rule: &GaussRule<T>,
     occ: &O,
-    z0: T,
-    z1: T,
+    ext: [T; 3],
+    edge_length: T,
+    gap: T,
     fold: T,
 ) -> T
 where
@@ -394,50 +614,174 @@ where
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
-    // Compensated: up to 6·order⁴·(grading) terms, summed in f32 too.
+    // Compensated: up to 6·order⁴·(shells) terms, summed in f32 too.
     let mut total = Compensated::default();
-    let dz = z1 - z0;
-    // Pyramid k: the largest of (|u|, η_a, η_b) is ζ. In pyramids 1 and 2 the kernel of two
-    // nearly folded patches peaks at p → 0 (u = 0), q → 1 (η_a = η_b) with width ≈ the fold
-    // angle: grade p and q towards that corner.
+    // Scaled variables X = (|u|, η_a, η_b) · ext ∈ [0, ext]: physically isotropic near the
+    // edge. Pyramid k: X_k = ζ is the largest; the other two are ζ·m_j(ζ)·ρ_j with
+    // m_j = min(1, ext_j/ζ) (the box cuts the pyramid beyond ζ = ext_j), ρ_j ∈ [0, 1].
+    let c = ext.map(|e| T::ONE / e);
+    let jac_scale = at(&c, 0) * at(&c, 1) * at(&c, 2);
+    let folded = fold > T::ZERO && fold < T::ONE;
     for pyramid in 0..3 {
-        let scale = if pyramid == 0 { T::ZERO } else { fold };
-        for_each_interval(scale, false, |p0, p1| {
-            for_each_interval(scale, true, |q0, q1| {
-                let (dp, dq) = (p1 - p0, q1 - q0);
+        let (o1, o2) = match pyramid {
+            0 => (1, 2),
+            1 => (0, 2),
+            _ => (0, 1),
+        };
+        let (ek, e1, e2) = (at(&ext, pyramid), at(&ext, o1), at(&ext, o2));
+        // In pyramids 1 and 2 the kernel of two nearly folded patches peaks at ρ₁ → 0 (u = 0)
+        // and at the ρ₂ where the other patch's line comes closest to the point at distance ζ
+        // from the edge (ρ₂ = 1 for equal scaled distances without a gap; 1 − g/ζ with a gap g
+        // along the patch; the far side of the narrower patch beyond its extent), with a
+        // width ≈ (closest distance) / (length of the line): both are found per ζ node and
+        // the ρ intervals graded towards them.
+        let grade = folded && pyramid != 0;
+        for_each_shell(gap, ek, &[e1, e2], |s0, s1| {
+            // Beyond the narrower patch's extent (ζ > e2 ≥ 1 in pyramid 1 or 2) its free edge
+            // hovers ≈ θ·(its width) over the other patch: the kernel also peaks at ζ → e2⁺;
+            // grade ζ towards e2 too. Likewise at ζ = gap, where the peak line of a gapped
+            // pair enters the pyramid.
+            let toward_break = if (s0 == e2 || s0 == gap) && grade { fold * s0 / (s1 - s0) } else { T::ZERO };
+            for_each_interval(toward_break, false, |t0, t1| {
+                let (z0, z1) = (s0 + (s1 - s0) * t0, s0 + (s1 - s0) * t1);
+                let dz = z1 - z0;
                 for (zu, wz) in unit_points(rule) {
                     let (zeta, wz) = (z0 + dz * zu, wz * dz);
-                    let jac_zeta = zeta * zeta;
-                    for (pu, wp) in unit_points(rule) {
-                        let (p, wp) = (p0 + dp * pu, wp * dp);
-                        for (qu, wq) in unit_points(rule) {
-                            let (q, wq) = (q0 + dq * qu, wq * dq);
-                            let (abs_u, eta_a, eta_b) = match pyramid {
-                                0 => (zeta, zeta * p, zeta * q),
-                                1 => (zeta * p, zeta, zeta * q),
-                                _ => (zeta * p, zeta * q, zeta),
-                            };
-                            let span = T::ONE - abs_u;
-                            let mut line = T::ZERO;
-                            for (sigma, ws) in unit_points(rule) {
-                                let lo = sigma * span;
-                                // u > 0: ξ_a = σ(1−u), ξ_b = ξ_a + u;  u < 0: ξ_b = σ(1−|u|), ξ_a = ξ_b + |u|.
-                                let (pa, na) = a.eval(lo, eta_a);
-                                let (pb, nb) = b.eval(lo + abs_u, eta_b);
-                                let mut k = kernel(pa, na, pb, nb, occ);
-                                let (pa2, na2) = a.eval(lo + abs_u, eta_a);
-                                let (pb2, nb2) = b.eval(lo, eta_b);
-                                k += kernel(pa2, na2, pb2, nb2, occ);
-                                line += ws * k;
+                    let (m1, m2) = ((e1 / zeta).min(T::ONE), (e2 / zeta).min(T::ONE));
+                    let jac = zeta * zeta * m1 * m2 * jac_scale;
+                    let (p_width, q_centre, q_width) = if grade {
+                        let half = T::HALF;
+                        let (point, line): (Vec3<T>, &dyn Fn(T) -> Vec3<T>) = if pyramid == 1 {
+                            (a.eval(half, (zeta * at(&c, 1)).min(T::ONE)).0, &|r: T| {
+                                b.eval(half, (zeta * m2 * r * at(&c, 2)).min(T::ONE)).0
+                            })
+                        } else {
+                            (b.eval(half, (zeta * at(&c, 2)).min(T::ONE)).0, &|r: T| {
+                                a.eval(half, (zeta * m2 * r * at(&c, 1)).min(T::ONE)).0
+                            })
+                        };
+                        let (r_star, d_min) = closest_on_line(point, line);
+                        let speed = (line(T::ONE) - line(T::ZERO)).norm();
+                        let u_length = edge_length * at(&c, 0) * zeta * m1;
+                        (ratio(d_min, u_length), r_star, ratio(d_min, speed))
+                    } else {
+                        (T::ZERO, T::ONE, T::ONE)
+                    };
+                    for_each_interval(p_width, false, |p0, p1| {
+                        for_each_interval_around(q_centre, q_width, |q0, q1| {
+                            let (dp, dq) = (p1 - p0, q1 - q0);
+                            for (pu, wp) in unit_points(rule) {
+                                let (p, wp) = (p0 + dp * pu, wp * dp);
+                                for (qu, wq) in unit_points(rule) {
+                                    let (q, wq) = (q0 + dq * qu, wq * dq);
+                                    let (x1, x2) = (zeta * m1 * p, zeta * m2 * q);
+                                    let (xu, xa, xb) = match pyramid {
+                                        0 => (zeta, x1, x2),
+                                        1 => (x1, zeta, x2),
+                                        _ => (x1, x2, zeta),
+                                    };
+                                    let abs_u = (xu * at(&c, 0)).min(T::ONE);
+                                    let (eta_a, eta_b) = ((xa * at(&c, 1)).min(T::ONE), (xb * at(&c, 2)).min(T::ONE));
+                                    let span = T::ONE - abs_u;
+                                    let mut line = T::ZERO;
+                                    for (sigma, ws) in unit_points(rule) {
+                                        let lo = sigma * span;
+                                        // u > 0: ξ_a = σ(1−u), ξ_b = ξ_a + u;
+                                        // u < 0: ξ_b = σ(1−|u|), ξ_a = ξ_b + |u|.
+                                        let (pa, na) = a.eval(lo, eta_a);
+                                        let (pb, nb) = b.eval(lo + abs_u, eta_b);
+                                        let mut k = kernel(pa, na, pb, nb, occ);
+                                        let (pa2, na2) = a.eval(lo + abs_u, eta_a);
+                                        let (pb2, nb2) = b.eval(lo, eta_b);
+                                        k += kernel(pa2, na2, pb2, nb2, occ);
+                                        line += ws * k;
+                                    }
+                                    total.add(wz * wp * wq * jac * span * line);
+                                }
                             }
-                            total.add(wz * wp * wq * jac_zeta * span * line);
-                        }
-                    }
+                        });
+                    });
                 }
             });
         });
     }
     total.value()
+}
+
+/// `num / den` as a grading width: 1 (no grading) when the quotient is not a small positive
+/// number.
+#[inline(always)]
+fn ratio<T: Real>(num: T, den: T) -> T {
+    let r = num / den;
+    if r > T::ZERO && r < T::ONE {
+        r
+    } else {
+        T::ONE
+    }
+}
+
+/// The parameter ρ ∈ [0, 1] where `line(ρ)` comes closest to `p` and that distance, by golden
+/// section (the distance along a patch's coordinate line is unimodal for the flat and gently
+/// curved pairs that need it; an approximate centre only shifts the grading).
+fn closest_on_line<T: Real>(p: Vec3<T>, line: &dyn Fn(T) -> Vec3<T>) -> (T, T) {
+    let d = |r: T| (line(r) - p).norm();
+    let g = T::from_f64(0.381_966_011_250_105_1);
+    let (mut lo, mut hi) = (T::ZERO, T::ONE);
+    let mut x1 = lo + g * (hi - lo);
+    let mut x2 = hi - g * (hi - lo);
+    let (mut f1, mut f2) = (d(x1), d(x2));
+    for _ in 0..48 {
+        if f1 <= f2 {
+            hi = x2;
+            x2 = x1;
+            f2 = f1;
+            x1 = lo + g * (hi - lo);
+            f1 = d(x1);
+        } else {
+            lo = x1;
+            x1 = x2;
+            f1 = f2;
+            x2 = hi - g * (hi - lo);
+            f2 = d(x2);
+        }
+    }
+    // The ends too (the minimum of a monotone distance is at an end).
+    let mut best = if f1 <= f2 { (x1, f1) } else { (x2, f2) };
+    for r in [T::ZERO, T::ONE] {
+        let f = d(r);
+        if f < best.1 {
+            best = (r, f);
+        }
+    }
+    best
+}
+
+/// Calls `f(lo, hi)` for the intervals of [0, 1] graded geometrically on both sides of `centre`:
+/// [c − δ, c + δ] ∩ [0, 1], then [c + δ, c + 4δ], [c − 4δ, c − δ], …; just [0, 1] when δ is not
+/// in (0, 1) or the centre is not in [0, 1].
+fn for_each_interval_around<T: Real>(centre: T, width: T, mut f: impl FnMut(T, T)) {
+    let width = width.max(T::from_f64(1e-12));
+    if !(width < T::ONE && centre >= T::ZERO && centre <= T::ONE) {
+        f(T::ZERO, T::ONE);
+        return;
+    }
+    let four = T::from_f64(4.0);
+    let (mut lo, mut hi) = ((centre - width).max(T::ZERO), (centre + width).min(T::ONE));
+    f(lo, hi);
+    let mut step = width;
+    while hi < T::ONE {
+        step *= four;
+        let next = (centre + step).min(T::ONE);
+        f(hi, next);
+        hi = next;
+    }
+    step = width;
+    while lo > T::ZERO {
+        step *= four;
+        let next = (centre - step).max(T::ZERO);
+        f(next, lo);
+        lo = next;
+    }
 }
 
 /// Kahan–Babuška (Neumaier) compensated sum.
@@ -507,8 +851,8 @@ fn vertex_sum<T, SA, SB, O>(
     b: &Local<'_, '_, T, SB>,
     rule: &GaussRule<T>,
     occ: &O,
-    z0: T,
-    z1: T,
+    ext: [T; 4],
+    gap: T,
 ) -> T
 where
     T: Real,
@@ -517,27 +861,110 @@ where
     O: Occluder<T> + ?Sized,
 {
     let mut total = Compensated::default();
-    let dz = z1 - z0;
-    for (zu, wz) in unit_points(rule) {
-        let (zeta, wz) = (z0 + dz * zu, wz * dz);
-        let jac = zeta * zeta * zeta;
-        for (p, wp) in unit_points(rule) {
-            for (q, wq) in unit_points(rule) {
-                for (r, wr) in unit_points(rule) {
-                    let (zp, zq, zr) = (zeta * p, zeta * q, zeta * r);
-                    let mut k = T::ZERO;
-                    // Four pyramids: the largest of (ξ_a, η_a, ξ_b, η_b) is ζ.
-                    for (xa, ya, xb, yb) in
-                        [(zeta, zp, zq, zr), (zp, zeta, zq, zr), (zp, zq, zeta, zr), (zp, zq, zr, zeta)]
-                    {
-                        let (pa, na) = a.eval(xa, ya);
-                        let (pb, nb) = b.eval(xb, yb);
-                        k += kernel(pa, na, pb, nb, occ);
+    // Scaled variables X = (ξ_a, η_a, ξ_b, η_b) · ext ∈ [0, ext]; pyramid k: X_k = ζ is the
+    // largest, the others ζ·m_j(ζ)·ρ_j with m_j = min(1, ext_j/ζ).
+    let c = ext.map(|e| T::ONE / e);
+    let jac_scale = at(&c, 0) * at(&c, 1) * at(&c, 2) * at(&c, 3);
+    // The point at local variables x (physical, in [0, 1]): index 0, 1 on A, 2, 3 on B.
+    let point =
+        |x: [T; 4], on_b: bool| if on_b { b.eval(at(&x, 2), at(&x, 3)).0 } else { a.eval(at(&x, 0), at(&x, 1)).0 };
+    let vertex = a.eval(T::ZERO, T::ZERO).0;
+    for pyramid in 0..4 {
+        let others: [usize; 3] = match pyramid {
+            0 => [1, 2, 3],
+            1 => [0, 2, 3],
+            2 => [0, 1, 3],
+            _ => [0, 1, 2],
+        };
+        let [o1, o2, o3] = others;
+        let (ek, e1, e2, e3) = (at(&ext, pyramid), at(&ext, o1), at(&ext, o2), at(&ext, o3));
+        let on_b = pyramid >= 2;
+        for_each_shell(gap, ek, &[e1, e2, e3], |z0, z1| {
+            let dz = z1 - z0;
+            for (zu, wz) in unit_points(rule) {
+                let (zeta, wz) = (z0 + dz * zu, wz * dz);
+                let m = [(e1 / zeta).min(T::ONE), (e2 / zeta).min(T::ONE), (e3 / zeta).min(T::ONE)];
+                let jac = zeta * zeta * zeta * at(&m, 0) * at(&m, 1) * at(&m, 2) * jac_scale;
+                // Local variable value of ratio slot s at ratio r.
+                let var = |s: usize, r: T| {
+                    let k = others.get(s).copied().unwrap_or(0);
+                    (zeta * at(&m, s) * r * at(&c, k)).min(T::ONE)
+                };
+                let with = |k: usize, v: T| {
+                    let mut x = [T::ZERO; 4];
+                    if let Some(slot) = x.get_mut(pyramid) {
+                        *slot = (zeta * at(&c, pyramid)).min(T::ONE);
                     }
-                    total.add(wz * wp * wq * wr * jac * k);
+                    if let Some(slot) = x.get_mut(k) {
+                        *slot = v;
+                    }
+                    x
+                };
+                // Nearly folded vertex pairs (cells along a folded edge): the point at ζ on this
+                // patch's edge may come close to an edge of the other patch (distance ≪ its
+                // distance from the vertex); then grade that ratio around the closest point and
+                // the other two ratios towards 0, with widths (closest distance)/(line length).
+                let p = point(with(pyramid, (zeta * at(&c, pyramid)).min(T::ONE)), on_b);
+                let reach = (p - vertex).norm();
+                let mut centre = [T::ZERO; 3];
+                let mut width = [T::ONE; 3];
+                // Slots of the other patch's two variables, and of this patch's other one.
+                let (s_other, s_same): ([usize; 2], usize) = if on_b { ([0, 1], 2) } else { ([1, 2], 0) };
+                let mut best: Option<(usize, T, T)> = None;
+                for s in s_other {
+                    let k = others.get(s).copied().unwrap_or(0);
+                    let line = |r: T| point(with(k, var(s, r)), !on_b);
+                    let (r_star, d_min) = closest_on_line(p, &line);
+                    if best.is_none_or(|(_, _, d)| d_min < d) {
+                        best = Some((s, r_star, d_min));
+                    }
                 }
+                if let Some((s_near, r_star, d_min)) = best {
+                    if d_min < T::from_f64(0.25) * reach {
+                        for s in [s_other[0], s_other[1], s_same] {
+                            let k = others.get(s).copied().unwrap_or(0);
+                            let same = s == s_same;
+                            let speed = (point(with(k, var(s, T::ONE)), same == on_b)
+                                - point(with(k, var(s, T::ZERO)), same == on_b))
+                            .norm();
+                            if let (Some(w), Some(cen)) = (width.get_mut(s), centre.get_mut(s)) {
+                                *w = ratio(d_min, speed);
+                                if s == s_near {
+                                    *cen = r_star;
+                                }
+                            }
+                        }
+                    }
+                }
+                for_each_interval_around(at(&centre, 0), at(&width, 0), |p0, p1| {
+                    for_each_interval_around(at(&centre, 1), at(&width, 1), |q0, q1| {
+                        for_each_interval_around(at(&centre, 2), at(&width, 2), |r0, r1| {
+                            let (dp, dq, dr) = (p1 - p0, q1 - q0, r1 - r0);
+                            for (pu, wp) in unit_points(rule) {
+                                let (p, wp) = (p0 + dp * pu, wp * dp);
+                                for (qu, wq) in unit_points(rule) {
+                                    let (q, wq) = (q0 + dq * qu, wq * dq);
+                                    for (ru, wr) in unit_points(rule) {
+                                        let (r, wr) = (r0 + dr * ru, wr * dr);
+                                        let (x1, x2, x3) = (var(0, p), var(1, q), var(2, r));
+                                        let xz = (zeta * at(&c, pyramid)).min(T::ONE);
+                                        let x = match pyramid {
+                                            0 => [xz, x1, x2, x3],
+                                            1 => [x1, xz, x2, x3],
+                                            2 => [x1, x2, xz, x3],
+                                            _ => [x1, x2, x3, xz],
+                                        };
+                                        let (pa, na) = a.eval(at(&x, 0), at(&x, 1));
+                                        let (pb, nb) = b.eval(at(&x, 2), at(&x, 3));
+                                        total.add(wz * wp * wq * wr * jac * kernel(pa, na, pb, nb, occ));
+                                    }
+                                }
+                            }
+                        });
+                    });
+                });
             }
-        }
+        });
     }
     total.value()
 }

@@ -58,13 +58,17 @@ pub fn perpendicular_rectangles(l: f64, w: f64, h: f64) -> f64 {
 /// **C-41** (Howell): coaxial parallel disks, emitter radius `r1`, receiver radius `r2`,
 /// distance `h`. `Rᵢ = rᵢ/h`, `X = 1 + (1 + R₂²)/R₁²`: `F = ½[X − √(X² − 4(R₂/R₁)²)]`.
 /// `r₁ = r₂ = h`: `(3 − √5)/2` = 0.3819660112501052. Accuracy: a few ulp (the difference is
-/// evaluated in the cancellation-free form `2(R₂/R₁)² / (X + √(X² − 4(R₂/R₁)²))`).
+/// evaluated in the cancellation-free form `2(R₂/R₁)² / (X + √(X² − 4(R₂/R₁)²))`, and
+/// `X² − 4(R₂/R₁)² = (X − 2R₂/R₁)(X + 2R₂/R₁)` with `X − 2R₂/R₁ = (1 + (R₁ − R₂)²)/R₁²` exactly,
+/// so h ≪ r does not cancel: equal disks at h = 1e-8 r give 1 − h/r + h²/(2r²)).
 pub fn coaxial_disks(r1: f64, r2: f64, h: f64) -> f64 {
     let rr1 = r1 / h;
     let rr2 = r2 / h;
     let x = 1.0 + (1.0 + rr2 * rr2) / (rr1 * rr1);
     let q = rr2 / rr1;
-    let root = (x * x - 4.0 * q * q).sqrt();
+    let d = rr1 - rr2;
+    let x_minus = (1.0 + d * d) / (rr1 * rr1);
+    let root = (x_minus * (x + 2.0 * q)).sqrt();
     // ½(X − √(X² − 4q²)) = 2q² / (X + √(X² − 4q²))
     2.0 * q * q / (x + root)
 }

@@ -156,11 +156,14 @@ fn disk_and_the_cylinder_wall_it_closes_share_a_curved_edge() {
     let axis = v::<f64>([0.0, 0.0, 1.0]);
     let base = Disk::new(v::<f64>([0.0; 3]), axis, r).unwrap();
     let wall = Cylinder::new(v::<f64>([0.0; 3]), axis, r, h, Side::Inner).unwrap();
+    // Separate pairs at order 16: at order 10 the rim cell against the wall band above its
+    // neighbour (distance = the cell width) is 2.4e-7 off with the plain rule, which dominates
+    // (it used to be masked by an error of opposite sign in the touching pairs).
     for (sectors, order, allowed) in [(4usize, 10usize, 1e-8), (8, 14, 1e-10)] {
         let f = grid_factor(
             PatchGrid::new(&base, 2, sectors).unwrap(),
             PatchGrid::new(&wall, sectors, 3).unwrap(),
-            settings(order, order),
+            settings(order.max(16), order),
         );
         let e = rel(f, reference);
         println!("disk -> cylinder wall, {sectors} sectors, order {order}: {f:.15} vs {reference:.15}: {e:.2e}");
