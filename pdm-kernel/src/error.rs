@@ -51,7 +51,7 @@ impl fmt::Display for PdmError {
             Self::CapacityExceeded { needed, capacity } => {
                 write!(f, "fixed capacity exceeded: need {needed}, have {capacity}")
             }
-            Self::InvalidResult => f.write_str("form factor is not a finite number in [0, 1]"),
+            Self::InvalidResult => f.write_str("form factor is not a finite, non-negative number"),
         }
     }
 }
