@@ -83,7 +83,7 @@ struct ValidateArgs {
     /// Face grid: K x K patches per face [default: 3].
     #[arg(long, value_name = "K", value_parser = parse_face_grid, allow_negative_numbers = true)]
     face_grid: Option<usize>,
-    /// Gauss points per axis [default: 5 in paper mode, 12 in accurate mode].
+    /// Gauss points per axis [default: 5 in paper mode, 8 in accurate mode].
     #[arg(long, value_name = "P", value_parser = parse_order, allow_negative_numbers = true)]
     order: Option<usize>,
     /// Gauss points per variable for patches sharing an edge or vertex (accurate mode).
@@ -226,7 +226,7 @@ fn run_validate(args: &ValidateArgs) -> ExitCode {
     };
     let order = args.order.unwrap_or(match mode {
         Mode::Paper => 5,
-        Mode::Accurate => 12,
+        Mode::Accurate => 8,
     });
     let config = RunConfig {
         mode,

@@ -301,11 +301,12 @@ where
             let sa = PatchSamples::<T, CAP>::new(a, order)?;
             let sb = PatchSamples::<T, CAP>::new(b, order)?;
             if occluders.may_block_between(&sa.bounds(), &sb.bounds()) {
-                // The kernel splits the outer patch 2 × 2 under a possible occluder.
+                // The kernel splits the outer patch under a possible occluder.
                 let (mut total, mut n) = (T::ZERO, 0u64);
                 let r = a.rect();
-                for k in 0..4 {
-                    let child = Patch::new(a.surface(), r.cell(k / 2, k % 2, 2, 2))?;
+                let m = pdm_kernel::pair::OCCLUDED_OUTER_SPLIT;
+                for k in 0..m * m {
+                    let child = Patch::new(a.surface(), r.cell(k / m, k % m, m, m))?;
                     let (v, c) = boundary_exchange_counted::<T, SA, SB, O, CAP>(&child, b, order, occluders)?;
                     total += v;
                     n = n.saturating_add(c);
