@@ -97,9 +97,12 @@ where
     let r = b.rect();
     let surface = b.surface();
     // Closed form when b is a parallelogram and every occluder can give its polynomials.
+    #[cfg(feature = "closed-form")]
     let affine = surface.affine_map();
+    #[cfg(not(feature = "closed-form"))]
+    let affine: Option<(Vec3<T>, Vec3<T>, Vec3<T>)> = None;
     let closed_form = match affine {
-        Some((o, et, _)) => !use_occluders || occluders.line_polynomials(o + et, o, et, &mut |_| {}),
+        Some((o, et, _)) => !use_occluders || occluder_polynomials(occluders, o + et, o, et, &mut |_| {}),
         None => false,
     };
     let inner = Inner {
@@ -128,6 +131,24 @@ where
 
 /// The nearest singular points just outside an interval, before and after it.
 type Outside<T> = (Option<T>, Option<T>);
+
+/// [`Occluder::line_polynomials`] when the `closed-form` feature is on; `false` otherwise.
+#[inline]
+fn occluder_polynomials<T: Real, O: Occluder<T> + ?Sized>(
+    occluders: &O,
+    p: Vec3<T>,
+    origin: Vec3<T>,
+    direction: Vec3<T>,
+    out: &mut dyn FnMut([T; 3]),
+) -> bool {
+    #[cfg(feature = "closed-form")]
+    return occluders.line_polynomials(p, origin, direction, out);
+    #[cfg(not(feature = "closed-form"))]
+    {
+        let _ = (occluders, p, origin, direction, out);
+        false
+    }
+}
 
 /// Most polynomials describing visibility along one line (two facing tests + the occluders').
 const MAX_POLYS: usize = 24;
@@ -193,7 +214,7 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
         polys.n = 0;
         polys.push([T::ZERO, np.dot(et), np.dot(w0)]);
         polys.push([T::ZERO, nq.dot(et), nq.dot(w0)]);
-        if self.use_occluders && !self.occluders.line_polynomials(p, origin, et, &mut |c| polys.push(c)) {
+        if self.use_occluders && !occluder_polynomials(self.occluders, p, origin, et, &mut |c| polys.push(c)) {
             return false;
         }
         !polys.overflow

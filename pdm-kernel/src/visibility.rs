@@ -56,6 +56,7 @@ pub trait Occluder<T: Real> {
     /// origins on a line (origin = o + s·v), every call passes the same number of polynomials
     /// in the same order, each coefficient a polynomial of degree ≤ 2 in s (true of anything
     /// built from dot products of origin − p taken at most twice).
+    #[cfg(feature = "closed-form")]
     fn line_polynomials(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut([T; 3])) -> bool {
         let _ = (p, origin, direction, out);
         false
@@ -93,6 +94,7 @@ pub(crate) fn polynomial_roots<T: Real>(a: T, b: T, c: T, out: &mut dyn FnMut(T)
 
 /// (m·w)² − k·|w|² along w(τ) = w₀ + τ·d, as the coefficients (a, b, c) of a τ² + b τ + c
 /// (zero where w lies on the cone of directions from p tangent to a sphere, k = |m|² − R²).
+#[cfg(feature = "closed-form")]
 #[inline]
 fn cone_polynomial<T: Real>(m: Vec3<T>, k: T, w0: Vec3<T>, d: Vec3<T>) -> (T, T, T) {
     let (md, mw) = (m.dot(d), m.dot(w0));
@@ -100,6 +102,7 @@ fn cone_polynomial<T: Real>(m: Vec3<T>, k: T, w0: Vec3<T>, d: Vec3<T>) -> (T, T,
 }
 
 /// |x(τ) − c|² − r² for x(τ) = x₀ + τ·d, as (a, b, c).
+#[cfg(feature = "closed-form")]
 #[inline]
 fn sphere_polynomial<T: Real>(x0: Vec3<T>, d: Vec3<T>, center: Vec3<T>, r: T) -> (T, T, T) {
     let f = x0 - center;
@@ -165,6 +168,7 @@ impl<T: Real> Occluder<T> for Sphere<T> {
     /// tangent cone ((m·w)² ≥ (|m|² − R²)|w|²), in front of p (m·w > 0), and it reaches the
     /// sphere (q inside, or the closest approach m·w/|w|² < 1, i.e. w·(q − c) > 0); p on the
     /// sphere switches at m·w = 0. All are polynomials of degree ≤ 2 in τ.
+    #[cfg(feature = "closed-form")]
     fn line_polynomials(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut([T; 3])) -> bool {
         let m = self.center - p;
         let w0 = origin - p;
@@ -253,6 +257,7 @@ impl<T: Real> Occluder<T> for Parallelogram<T> {
     /// The crossing τ = offset / (n·w) and its coordinates (u, v) are ratios of polynomials
     /// linear in τ: the switches are n·w = 0, q on the plane, and u, v ∈ {0, 1} (numerators
     /// multiplied by n·w).
+    #[cfg(feature = "closed-form")]
     fn line_polynomials(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut([T; 3])) -> bool {
         let n = self.normal;
         let nn = n.norm2();
@@ -300,6 +305,7 @@ impl<T: Real> Occluder<T> for Disk<T> {
     }
     /// As for the parallelogram, with the radius conditions |(n·w)(hit − c)|² = r²(n·w)²
     /// quadratic in τ.
+    #[cfg(feature = "closed-form")]
     fn line_polynomials(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut([T; 3])) -> bool {
         let n = self.frame.axis;
         let (w0, d) = (origin - p, direction);
@@ -377,6 +383,7 @@ impl<T: Real> Occluder<T> for AnyOccluder<T> {
             Self::Cylinder(o) => o.may_block_between(a, b),
         }
     }
+    #[cfg(feature = "closed-form")]
     fn line_polynomials(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut([T; 3])) -> bool {
         match self {
             Self::Sphere(o) => o.line_polynomials(p, origin, direction, out),
@@ -395,6 +402,7 @@ impl<T: Real> Occluder<T> for () {
     fn may_block_between(&self, _a: &Ball<T>, _b: &Ball<T>) -> bool {
         false
     }
+    #[cfg(feature = "closed-form")]
     fn line_polynomials(
         &self,
         _p: Vec3<T>,
@@ -413,6 +421,7 @@ impl<T: Real, O: Occluder<T> + ?Sized> Occluder<T> for &O {
     fn may_block_between(&self, a: &Ball<T>, b: &Ball<T>) -> bool {
         (**self).may_block_between(a, b)
     }
+    #[cfg(feature = "closed-form")]
     fn line_polynomials(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut([T; 3])) -> bool {
         (**self).line_polynomials(p, origin, direction, out)
     }
@@ -425,6 +434,7 @@ impl<T: Real, O: Occluder<T>> Occluder<T> for [O] {
     fn may_block_between(&self, a: &Ball<T>, b: &Ball<T>) -> bool {
         self.iter().any(|o| o.may_block_between(a, b))
     }
+    #[cfg(feature = "closed-form")]
     fn line_polynomials(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut([T; 3])) -> bool {
         self.iter().all(|o| o.line_polynomials(p, origin, direction, out))
     }
@@ -437,6 +447,7 @@ impl<T: Real, O: Occluder<T>, const N: usize> Occluder<T> for [O; N] {
     fn may_block_between(&self, a: &Ball<T>, b: &Ball<T>) -> bool {
         self.as_slice().may_block_between(a, b)
     }
+    #[cfg(feature = "closed-form")]
     fn line_polynomials(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut([T; 3])) -> bool {
         self.iter().all(|o| o.line_polynomials(p, origin, direction, out))
     }
@@ -449,6 +460,7 @@ impl<T: Real, O: Occluder<T>, const N: usize> Occluder<T> for heapless::Vec<O, N
     fn may_block_between(&self, a: &Ball<T>, b: &Ball<T>) -> bool {
         self.as_slice().may_block_between(a, b)
     }
+    #[cfg(feature = "closed-form")]
     fn line_polynomials(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut([T; 3])) -> bool {
         self.iter().all(|o| o.line_polynomials(p, origin, direction, out))
     }
@@ -461,6 +473,7 @@ impl<T: Real, O: Occluder<T>> Occluder<T> for Option<O> {
     fn may_block_between(&self, a: &Ball<T>, b: &Ball<T>) -> bool {
         self.as_ref().is_some_and(|o| o.may_block_between(a, b))
     }
+    #[cfg(feature = "closed-form")]
     fn line_polynomials(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut([T; 3])) -> bool {
         self.as_ref().is_none_or(|o| o.line_polynomials(p, origin, direction, out))
     }
@@ -473,6 +486,7 @@ impl<T: Real, A: Occluder<T>, B: Occluder<T>> Occluder<T> for (A, B) {
     fn may_block_between(&self, a: &Ball<T>, b: &Ball<T>) -> bool {
         self.0.may_block_between(a, b) || self.1.may_block_between(a, b)
     }
+    #[cfg(feature = "closed-form")]
     fn line_polynomials(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut([T; 3])) -> bool {
         self.0.line_polynomials(p, origin, direction, out) && self.1.line_polynomials(p, origin, direction, out)
     }
@@ -485,6 +499,7 @@ impl<T: Real, A: Occluder<T>, B: Occluder<T>, C: Occluder<T>> Occluder<T> for (A
     fn may_block_between(&self, a: &Ball<T>, b: &Ball<T>) -> bool {
         self.0.may_block_between(a, b) || self.1.may_block_between(a, b) || self.2.may_block_between(a, b)
     }
+    #[cfg(feature = "closed-form")]
     fn line_polynomials(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut([T; 3])) -> bool {
         self.0.line_polynomials(p, origin, direction, out)
             && self.1.line_polynomials(p, origin, direction, out)
@@ -565,6 +580,7 @@ mod tests {
     /// Every change of `blocks(p, origin + τ·direction)` along a line lies at a root of one of
     /// the occluder's `line_polynomials`: sampled densely on random lines, each change is
     /// bracketed by two samples 1e-4 apart and must contain a candidate.
+    #[cfg(feature = "closed-form")]
     fn check_line_breaks<O: Occluder<f64>>(occluder: &O, seed: u64) -> usize {
         let mut state = seed;
         let mut next = || {
@@ -606,6 +622,7 @@ mod tests {
         changes
     }
 
+    #[cfg(feature = "closed-form")]
     #[test]
     fn line_polynomials_vanish_at_every_change_of_visibility() {
         let sphere = Sphere::new(vec3(0.2, -0.1, 0.0), 1.3, Side::Outer).unwrap();

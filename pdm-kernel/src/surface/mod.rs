@@ -116,6 +116,7 @@ pub trait Surface<T: Real> {
     /// s·edge_s, with the constant normal ±edge_t × edge_s (a parallelogram). Visibility
     /// boundaries on such a patch are roots of low-degree polynomials, which
     /// [`crate::boundary`] solves in closed form instead of bisecting. Default: `None`.
+    #[cfg(feature = "closed-form")]
     #[inline]
     fn affine_map(&self) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {
         None
@@ -135,6 +136,7 @@ impl<T: Real, S: Surface<T> + ?Sized> Surface<T> for &S {
     fn point_and_normal(&self, t: T, s: T) -> (Vec3<T>, Vec3<T>) {
         (**self).point_and_normal(t, s)
     }
+    #[cfg(feature = "closed-form")]
     fn affine_map(&self) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {
         (**self).affine_map()
     }
@@ -208,6 +210,7 @@ impl<T: Real, S: Surface<T>> Surface<T> for Flipped<S> {
         let (p, n) = self.0.point_and_normal(t, s);
         (p, -n)
     }
+    #[cfg(feature = "closed-form")]
     fn affine_map(&self) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {
         self.0.affine_map()
     }

@@ -91,6 +91,7 @@ impl<T: Real> Surface<T> for Parallelogram<T> {
     fn normal(&self, _t: T, _s: T) -> Vec3<T> {
         self.normal
     }
+    #[cfg(feature = "closed-form")]
     #[inline]
     fn affine_map(&self) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {
         Some((self.origin, self.edge_t, self.edge_s))
