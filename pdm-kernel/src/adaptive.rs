@@ -94,7 +94,6 @@ where
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
-    let tol = settings.tolerance;
     let (adjacency, gap) = classify_near(a, b);
     match adjacency {
         Adjacency::SharedEdge { .. } | Adjacency::SharedVertex { .. } => {
@@ -118,26 +117,9 @@ where
                     4 * p4
                 }
             };
-            let mut p = 6;
-            let mut evaluations = per_order(p);
-            let mut prev = touching_exchange(a, b, adjacency, gap, p, occluders)?;
-            loop {
-                let next_p = p + 2;
-                let next = touching_exchange(a, b, adjacency, gap, next_p, occluders)?;
-                evaluations += per_order(next_p);
-                let error = (next - prev).abs();
-                if error <= tol * next.abs() {
-                    return Ok(Estimate { value: next, error, evaluations });
-                }
-                if next_p + 2 > settings.max_order.max(8) {
-                    if depth >= settings.max_depth {
-                        return Ok(Estimate { value: next, error, evaluations });
-                    }
-                    return split::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, evaluations);
-                }
-                prev = next;
-                p = next_p;
-            }
+            let eval = |p: usize| Ok((touching_exchange(a, b, adjacency, gap, p, occluders)?, per_order(p)));
+            let last_order = settings.max_order.max(8);
+            by_order_doubling::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, eval, 6, last_order)
         }
         Adjacency::Identical => {
             let p = settings.max_order.min(crate::gauss::MAX_ORDER - 1);
@@ -182,36 +164,53 @@ where
     let max_order = settings.max_order.clamp(6, crate::gauss::MAX_ORDER - 2);
     p = p.min(max_order);
 
-    let mut evaluations = 0u64;
     let sa = PatchSamples::<T, CAP>::new(a, p)?;
     let sb = PatchSamples::<T, CAP>::new(b, p)?;
-    let may_occlude = occluders.may_block_between(&sa.bounds(), &sb.bounds());
-    let boundaries = may_occlude || straddles_curvature_cut(&sa, &sb);
-    if boundaries {
+    if occluders.may_block_between(&sa.bounds(), &sb.bounds()) || straddles_curvature_cut(&sa, &sb) {
         return across_boundaries::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth);
     }
-    // Below order 4 (6 with boundaries) two successive orders can agree by accident; start there.
-    p = p.max(if boundaries { 6 } else { 4 }).min(max_order - 2);
+    // Below order 4 two successive orders can agree by accident; start there.
+    p = p.max(4).min(max_order - 2);
     let eval = |order: usize| -> Result<(T, u64), PdmError> {
-        if boundaries {
-            boundary_exchange_counted::<T, SA, SB, O, CAP>(a, b, order, occluders)
-        } else {
-            let sa = PatchSamples::<T, CAP>::new(a, order)?;
-            let sb = PatchSamples::<T, CAP>::new(b, order)?;
-            Ok((exchange(&sa, &sb, occluders)?, (sa.len() * sb.len()) as u64))
-        }
+        let sa = PatchSamples::<T, CAP>::new(a, order)?;
+        let sb = PatchSamples::<T, CAP>::new(b, order)?;
+        Ok((exchange(&sa, &sb, occluders)?, (sa.len() * sb.len()) as u64))
     };
-    let (mut prev, n0) = eval(p)?;
-    evaluations += n0;
+    by_order_doubling::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, eval, p, max_order)
+}
+
+/// Evaluates the pair at orders p, p + 2, … (`eval` gives the value and its evaluations) until
+/// two successive values agree to the tolerance (the difference is the estimate); when the
+/// next order would pass `last_order`, splits the pair instead (or, at the depth limit,
+/// returns the last value with its estimate).
+#[allow(clippy::too_many_arguments)]
+fn by_order_doubling<T, SA, SB, O, const CAP: usize>(
+    a: &Patch<'_, T, SA>,
+    b: &Patch<'_, T, SB>,
+    settings: Adaptive<T>,
+    occluders: &O,
+    depth: u32,
+    eval: impl Fn(usize) -> Result<(T, u64), PdmError>,
+    first_order: usize,
+    last_order: usize,
+) -> Result<Estimate<T>, PdmError>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
+    let mut p = first_order;
+    let (mut prev, mut evaluations) = eval(p)?;
     loop {
         let next_p = p + 2;
         let (next, n) = eval(next_p)?;
         evaluations += n;
         let error = (next - prev).abs();
-        if error <= tol * next.abs() || (error <= T::MIN_POSITIVE) {
+        if error <= settings.tolerance * next.abs() || error <= T::MIN_POSITIVE {
             return Ok(Estimate { value: next, error, evaluations });
         }
-        if next_p + 2 > max_order {
+        if next_p + 2 > last_order {
             if depth >= settings.max_depth {
                 return Ok(Estimate { value: next, error, evaluations });
             }

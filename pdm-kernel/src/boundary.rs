@@ -296,14 +296,12 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
             let four = T::TWO * T::TWO;
             [v0, four * vh - T::from_f64(3.0) * v0 - v1, T::TWO * (v1 + v0) - four * vh]
         };
-        for ((c0, ch), c1) in p0.used().iter().zip(ph.used()).zip(p1.used()) {
-            let (Some(&[a0, b0, k0]), Some(&[ah, bh, kh]), Some(&[a1, b1, k1])) = (Some(c0), Some(ch), Some(c1)) else {
-                continue;
-            };
+        for ((&[a0, b0, k0], &[ah, bh, kh]), &[a1, b1, k1]) in p0.used().iter().zip(ph.used()).zip(p1.used()) {
             let qa = fit(a0, ah, a1);
             let qb = fit(b0, bh, b1);
             let qc = fit(k0, kh, k1);
-            // A root crossing the t-edges: P(t_edge; x) = a(x) t² + b(x) t + c(x).
+            // A root crossing the t-edges: P(t_edge; x) = a(x) t² + b(x) t + c(x), coefficient by
+            // coefficient in x.
             for t in [r.t0, r.t1] {
                 let e = |k: usize| {
                     let g = |q: &[T; 3]| q.get(k).copied().unwrap_or(T::ZERO);
@@ -330,9 +328,9 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
         sort(used);
         // Keep the candidates where the line structure actually changes.
         let delta = h * T::EPSILON.sqrt();
+        let mut kept_at = [T::ZERO; MAX_BREAKS + 2];
         let mut kept = 0usize;
         let mut last = r.s0 - h;
-        let start = *n;
         let mut outside: Outside<T> = (None, None);
         for &c in used.iter() {
             if c - last <= delta {
@@ -348,22 +346,16 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
                     }
                 } else {
                     push(out, n, c)?;
-                    kept += 1;
+                    push(&mut kept_at, &mut kept, c)?;
                 }
             }
         }
         // Anything else between them: bracket and bisect.
         let signature = |s: T| self.line_signature(p, np, s);
         let mut lo = r.s0;
-        let fixed = out.get(start..*n).map_or([T::ZERO; MAX_BREAKS + 2], |f| {
-            let mut copy = [T::ZERO; MAX_BREAKS + 2];
-            for (d, s) in copy.iter_mut().zip(f) {
-                *d = *s;
-            }
-            copy
-        });
         for k in 0..=kept {
-            let hi = if k < kept { fixed.get(k).copied().unwrap_or(r.s1) - delta } else { r.s1 };
+            let next = if k < kept { kept_at.get(k).copied() } else { None };
+            let hi = next.map_or(r.s1, |c| c - delta);
             let from = if k == 0 { lo } else { lo + delta };
             if hi > from {
                 let span = (hi - from) / h;
@@ -374,7 +366,7 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
                 }
                 locate_changes(&signature, from, hi, probes, out, n)?;
             }
-            lo = fixed.get(k).copied().unwrap_or(r.s1);
+            lo = next.unwrap_or(r.s1);
         }
         Ok(outside)
     }
