@@ -102,12 +102,8 @@ where
             // faces 1 → 2 with the sphere, tolerance 1e-3, error 1.4e-3 against an estimate of
             // 7.5e-4). Split both patches 2 × 2 until no occluder can cut a touching sub-pair;
             // the separate sub-pairs take the boundary-aware path.
-            if depth < settings.max_depth {
-                let (ba, bb) =
-                    (PatchSamples::<T, CAP>::new(a, 2)?.bounds(), PatchSamples::<T, CAP>::new(b, 2)?.bounds());
-                if occluders.may_block_between(&ba, &bb) {
-                    return split_both::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth);
-                }
+            if depth < settings.max_depth && occluders.may_block_between(&a.enclosing_ball(), &b.enclosing_ball()) {
+                return split_both::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth);
             }
             let per_order = |p: usize| -> u64 {
                 let p4 = (p as u64).pow(4);
@@ -166,7 +162,7 @@ where
 
     let sa = PatchSamples::<T, CAP>::new(a, p)?;
     let sb = PatchSamples::<T, CAP>::new(b, p)?;
-    if occluders.may_block_between(&sa.bounds(), &sb.bounds()) || straddles_curvature_cut(&sa, &sb) {
+    if occluders.may_block_between(&a.enclosing_ball(), &b.enclosing_ball()) || straddles_curvature_cut(&sa, &sb) {
         return across_boundaries::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth);
     }
     // Below order 4 two successive orders can agree by accident; start there.

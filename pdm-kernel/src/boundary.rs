@@ -51,9 +51,9 @@ use crate::error::PdmError;
 use crate::gauss::GaussRule;
 use crate::patch::Patch;
 use crate::real::Real;
-use crate::samples::PatchSamples;
+use crate::samples::{Ball, PatchSamples};
 use crate::surface::{ParamRect, Surface};
-use crate::vec3::Vec3;
+use crate::vec3::{vec3, Vec3};
 use crate::visibility::Occluder;
 
 /// Largest number of visibility changes located on one inner line.
@@ -93,7 +93,6 @@ where
     let count = core::cell::Cell::new(0u64);
     let outer = PatchSamples::<T, CAP>::new(a, order)?;
     let inner_samples = PatchSamples::<T, CAP>::new(b, order)?; // validates b (area, finiteness)
-    let use_occluders = occluders.may_block_between(&outer.bounds(), &inner_samples.bounds());
     let r = b.rect();
     let surface = b.surface();
     // Closed form when b is a parallelogram and every occluder can give its polynomials.
@@ -101,6 +100,20 @@ where
     let affine = surface.affine_map();
     #[cfg(not(feature = "closed-form"))]
     let affine: Option<(Vec3<T>, Vec3<T>, Vec3<T>)> = None;
+    // Whether an occluder can cut the integrand anywhere on b (not only at its Gauss points);
+    // a flat b's corners give the smallest ball containing it.
+    let inner_bounds = match affine {
+        Some((o, et, es)) => {
+            let corner = |t: T, s: T| o + et.scale(t) + es.scale(s);
+            let center = corner((r.t0 + r.t1) * T::HALF, (r.s0 + r.s1) * T::HALF);
+            let radius = [(r.t0, r.s0), (r.t1, r.s0), (r.t0, r.s1), (r.t1, r.s1)]
+                .iter()
+                .fold(T::ZERO, |acc, &(t, s)| acc.max((corner(t, s) - center).norm()));
+            Ball { center, radius: radius * (T::ONE + T::GEOMETRY_TOLERANCE) }
+        }
+        None => b.enclosing_ball(),
+    };
+    let use_occluders = occluders.may_block_between(&a.enclosing_ball(), &inner_bounds);
     let closed_form = match affine {
         Some((o, et, _)) => !use_occluders || occluder_polynomials(occluders, o + et, o, et, &mut |_| {}),
         None => false,
@@ -120,7 +133,33 @@ where
         if sample.weight == T::ZERO {
             continue;
         }
-        total += sample.weight * inner.integral(sample.point, sample.unit_normal)?;
+        let (p, np) = (sample.point, sample.unit_normal);
+        // From most points nothing cuts b: an occluder can cut only if it meets the cone of
+        // segments from p to b's bounding ball, and on a flat b the facing tests are affine,
+        // so b's corners decide them. The integrand is then smooth (plain rule) or zero.
+        let occluded_from_p =
+            use_occluders && occluders.may_block_between(&Ball { center: p, radius: T::ZERO }, &inner_bounds);
+        if occluded_from_p && occluder_hides(occluders, p, &inner_bounds) {
+            continue;
+        }
+        let j = match (occluded_from_p, inner.facing_from(p, np)) {
+            (false, Some(true)) => {
+                let (x, y, z, nx, ny, nz, w) = inner_samples.columns();
+                let mut sum = T::ZERO;
+                for k in 0..w.len() {
+                    if let (Some(&qx), Some(&qy), Some(&qz), Some(&ax), Some(&ay), Some(&az), Some(&wk)) =
+                        (x.get(k), y.get(k), z.get(k), nx.get(k), ny.get(k), nz.get(k), w.get(k))
+                    {
+                        sum += wk * kernel_unoccluded(p, np, vec3(qx, qy, qz), vec3(ax, ay, az));
+                    }
+                }
+                count.set(count.get().saturating_add(w.len() as u64));
+                sum
+            }
+            (_, Some(false)) => T::ZERO,
+            _ => inner.integral(p, np)?,
+        };
+        total += sample.weight * j;
     }
     let value = total * T::FRAC_1_PI;
     if !value.is_finite() || value < T::ZERO {
@@ -131,6 +170,18 @@ where
 
 /// The nearest singular points just outside an interval, before and after it.
 type Outside<T> = (Option<T>, Option<T>);
+
+/// [`Occluder::hides_ball_from`] when the `closed-form` feature is on; `false` otherwise.
+#[inline]
+fn occluder_hides<T: Real, O: Occluder<T> + ?Sized>(occluders: &O, p: Vec3<T>, b: &Ball<T>) -> bool {
+    #[cfg(feature = "closed-form")]
+    return occluders.hides_ball_from(p, b);
+    #[cfg(not(feature = "closed-form"))]
+    {
+        let _ = (occluders, p, b);
+        false
+    }
+}
 
 /// [`Occluder::line_polynomials`] when the `closed-form` feature is on; `false` otherwise.
 #[inline]
@@ -194,6 +245,31 @@ struct Inner<'x, T: Real, SB: ?Sized, O: ?Sized> {
 impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB, O> {
     fn tick(&self) {
         self.count.set(self.count.get().saturating_add(1));
+    }
+
+    /// On a flat b (closed-form mode), the facing tests from p over all of b, decided at b's
+    /// corners (both are affine on b): `Some(true)` if every q of b and p face each other,
+    /// `Some(false)` if none do, `None` if b straddles a facing boundary or is not flat.
+    fn facing_from(&self, p: Vec3<T>, np: Vec3<T>) -> Option<bool> {
+        let (o, et, es) = self.affine?;
+        let r = self.r;
+        let nq = self.surface.normal(r.t0, r.s0);
+        let corners = [(r.t0, r.s0), (r.t1, r.s0), (r.t0, r.s1), (r.t1, r.s1)];
+        let (mut sees, mut ahead_of_p, mut ahead_of_q) = (0usize, 0usize, 0usize);
+        for (t, s) in corners {
+            let e = o + et.scale(t) + es.scale(s) - p;
+            let (towards_q, towards_p) = (np.dot(e) > T::ZERO, nq.dot(e) < T::ZERO);
+            sees += usize::from(towards_q && towards_p);
+            ahead_of_p += usize::from(towards_q);
+            ahead_of_q += usize::from(towards_p);
+        }
+        if sees == corners.len() {
+            Some(true)
+        } else if ahead_of_p == 0 || ahead_of_q == 0 {
+            Some(false)
+        } else {
+            None
+        }
     }
 
     /// Both facing tests and the occluders for the segment p → q.

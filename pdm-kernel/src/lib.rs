@@ -61,7 +61,7 @@ pub use dual::{Dual, Scalar};
 pub use error::PdmError;
 pub use form_factor::{exchange, form_factor, form_factor_between, self_form_factor, surface_form_factor, Quadrature};
 pub use gauss::{GaussRule, MAX_ORDER};
-pub use pair::{pair_exchange, PairSettings};
+pub use pair::{pair_exchange, pair_exchange_counted, PairSettings};
 pub use patch::{Patch, PatchGrid};
 pub use real::Real;
 pub use samples::{Ball, PatchSamples, Sample};

@@ -11,7 +11,7 @@
 //!   plain sum.
 
 use crate::adaptive::straddles_curvature_cut;
-use crate::boundary::boundary_exchange;
+use crate::boundary::boundary_exchange_counted;
 use crate::error::PdmError;
 use crate::form_factor::exchange;
 use crate::patch::Patch;
@@ -61,39 +61,68 @@ where
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
+    pair_exchange_counted::<T, SA, SB, O, CAP>(a, b, settings, occluders).map(|(value, _)| value)
+}
+
+/// [`pair_exchange`] and the work it did, in integrand evaluations: kernel evaluations and
+/// visibility probes on the boundary path ([`crate::boundary_exchange_counted`]), order⁴ for a
+/// plain sum and order⁴ more for the straddle check, 6·p⁴ for a shared edge and 4·p⁴ for a
+/// shared vertex (p = `singular_order`), (order·(order + 1))² for a self pair.
+pub fn pair_exchange_counted<T, SA, SB, O, const CAP: usize>(
+    a: &Patch<'_, T, SA>,
+    b: &Patch<'_, T, SB>,
+    settings: PairSettings,
+    occluders: &O,
+) -> Result<(T, u64), PdmError>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
+    let p4 = (settings.order as u64).pow(4);
     let (adjacency, gap) = classify_near(a, b);
     match adjacency {
         Adjacency::SharedEdge { .. } | Adjacency::SharedVertex { .. } => {
-            touching_exchange(a, b, adjacency, gap, settings.singular_order, occluders)
+            let q4 = (settings.singular_order as u64).pow(4);
+            let count = if matches!(adjacency, Adjacency::SharedEdge { .. }) { 6 * q4 } else { 4 * q4 };
+            Ok((touching_exchange(a, b, adjacency, gap, settings.singular_order, occluders)?, count))
         }
         Adjacency::Identical => {
             let f = crate::form_factor::self_form_factor::<T, SA, O, CAP>(a, settings.order, occluders)?;
             let sa = PatchSamples::<T, CAP>::new(a, settings.order)?;
-            Ok(f * sa.area())
+            let q = (settings.order * (settings.order + 1)) as u64;
+            Ok((f * sa.area(), q * q))
         }
         Adjacency::Separate => {
             let sa = PatchSamples::<T, CAP>::new(a, settings.order)?;
             let sb = PatchSamples::<T, CAP>::new(b, settings.order)?;
             if !settings.boundaries {
-                return exchange(&sa, &sb, occluders);
+                return Ok((exchange(&sa, &sb, occluders)?, p4));
             }
-            let may_occlude = occluders.may_block_between(&sa.bounds(), &sb.bounds());
+            // The sample balls decide for the plain sum; the integrand is smooth only if no
+            // occluder cuts any segment between the patches (enclosing balls).
+            let may_occlude = occluders.may_block_between(&sa.bounds(), &sb.bounds())
+                || occluders.may_block_between(&a.enclosing_ball(), &b.enclosing_ball());
             if may_occlude {
                 // Shadow edges crossing b make the outer integrand kink where they touch b's
                 // edges; the outer patch is split (see OCCLUDED_OUTER_SPLIT).
-                let mut total = T::ZERO;
+                let (mut total, mut count) = (T::ZERO, 0u64);
                 let r = a.rect();
                 let n = OCCLUDED_OUTER_SPLIT;
                 for k in 0..n * n {
                     let child = Patch::new(a.surface(), r.cell(k / n, k % n, n, n))?;
-                    total += boundary_exchange::<T, SA, SB, O, CAP>(&child, b, settings.order, occluders)?;
+                    let (v, c) = boundary_exchange_counted::<T, SA, SB, O, CAP>(&child, b, settings.order, occluders)?;
+                    total += v;
+                    count = count.saturating_add(c);
                 }
-                Ok(total)
+                Ok((total, count))
             } else if straddles_curvature_cut(&sa, &sb) {
-                boundary_exchange::<T, SA, SB, (), CAP>(a, b, settings.order, &())
+                let (v, c) = boundary_exchange_counted::<T, SA, SB, (), CAP>(a, b, settings.order, &())?;
+                Ok((v, c.saturating_add(p4)))
             } else {
                 // Smooth pair: nothing to place into the rule, no occluder can cut it.
-                exchange(&sa, &sb, &())
+                Ok((exchange(&sa, &sb, &())?, 2 * p4))
             }
         }
     }

@@ -4,6 +4,7 @@
 use crate::error::PdmError;
 use crate::gauss::GaussRule;
 use crate::real::Real;
+use crate::samples::Ball;
 use crate::surface::{ParamRect, Surface};
 
 /// A surface restricted to the parameter rectangle `rect` ⊆ its domain.
@@ -49,6 +50,29 @@ impl<'s, T: Real, S: Surface<T> + ?Sized> Patch<'s, T, S> {
     #[must_use]
     pub fn rect(&self) -> ParamRect<T> {
         self.rect
+    }
+
+    /// A ball containing the whole patch (not only its Gauss points): centred at g(mid), radius
+    /// the largest distance to a 5 × 5 grid of points including the corners and edges, enlarged
+    /// by 1/8. Exact up to that margin for flat patches (a parallelogram's farthest point is a
+    /// corner); for curved ones the margin covers the bulge between grid points of any patch
+    /// whose normal turns by less than a right angle (sphere, cylinder, cone, disk cells).
+    /// Used to decide whether an occluder can cut the pair's integrand anywhere.
+    #[must_use]
+    pub fn enclosing_ball(&self) -> Ball<T> {
+        const GRID: usize = 5;
+        let r = self.rect;
+        let center = self.surface.point((r.t0 + r.t1) * T::HALF, (r.s0 + r.s1) * T::HALF);
+        let mut radius = T::ZERO;
+        let step = T::ONE / T::from_usize(GRID - 1);
+        for i in 0..GRID {
+            let t = r.t0 + (r.t1 - r.t0) * (T::from_usize(i) * step);
+            for j in 0..GRID {
+                let s = r.s0 + (r.s1 - r.s0) * (T::from_usize(j) * step);
+                radius = radius.max((self.surface.point(t, s) - center).norm());
+            }
+        }
+        Ball { center, radius: radius * (T::ONE + T::from_f64(0.125)) }
     }
 
     /// Area by eq. (12), A = ∫∫ |n| ds dt, with the `order`-point Gauss rule on each axis.
@@ -173,7 +197,41 @@ impl<T: Real, S: Surface<T> + ?Sized> ExactSizeIterator for PatchGrid<'_, T, S> 
 mod tests {
     use super::*;
     use crate::surface::{Cylinder, Parallelogram, Side, Sphere};
-    use crate::vec3::vec3;
+    use crate::vec3::{vec3, Vec3};
+
+    /// Every point of a dense grid lies in the enclosing ball, for flat and curved cells up to
+    /// a whole hemisphere band; for a flat cell the ball is the corners' (up to the 1/8 margin).
+    #[test]
+    fn enclosing_ball_contains_the_whole_patch() {
+        let sphere = Sphere::outer(vec3(0.5, -1.0, 2.0), 1.3).unwrap();
+        let cylinder = Cylinder::new(vec3(0.0, 0.0, 0.0), vec3(0.0, 0.0, 1.0), 0.7, 2.0, Side::Outer).unwrap();
+        let square = Parallelogram::new(vec3(0.0, 0.0, 0.0), vec3(2.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0)).unwrap();
+        let check = |patch_points: &dyn Fn(f64, f64) -> Vec3<f64>, ball: Ball<f64>| {
+            for i in 0..=200 {
+                for j in 0..=200 {
+                    let x = patch_points(f64::from(i) / 200.0, f64::from(j) / 200.0);
+                    assert!((x - ball.center).norm() <= ball.radius, "{x:?} outside {ball:?}");
+                }
+            }
+        };
+        for (m, n) in [(1, 1), (2, 2), (2, 4), (8, 8)] {
+            for patch in PatchGrid::new(&sphere, m, n).unwrap() {
+                let r = patch.rect();
+                check(&|u, v| sphere.point(r.t0 + u * (r.t1 - r.t0), r.s0 + v * (r.s1 - r.s0)), patch.enclosing_ball());
+            }
+            for patch in PatchGrid::new(&cylinder, m, n).unwrap() {
+                let r = patch.rect();
+                check(
+                    &|u, v| cylinder.point(r.t0 + u * (r.t1 - r.t0), r.s0 + v * (r.s1 - r.s0)),
+                    patch.enclosing_ball(),
+                );
+            }
+        }
+        let ball = Patch::whole(&square).unwrap().enclosing_ball();
+        let half_diagonal = 5.0f64.sqrt() / 2.0;
+        assert!((ball.radius / half_diagonal - 1.125).abs() < 1e-12, "{ball:?}");
+        assert!((ball.center - vec3(1.0, 0.5, 0.0)).norm() < 1e-15);
+    }
 
     #[test]
     fn sphere_zone_area_converges_to_exact() {

@@ -61,6 +61,15 @@ pub trait Occluder<T: Real> {
         let _ = (p, origin, direction, out);
         false
     }
+
+    /// Conservative culling the other way: `true` only if every segment from `p` to a point of
+    /// ball `b` is blocked (then nothing of b is visible from p). The default says "not sure"
+    /// (`false`).
+    #[cfg(feature = "closed-form")]
+    fn hides_ball_from(&self, p: Vec3<T>, b: &Ball<T>) -> bool {
+        let _ = (p, b);
+        false
+    }
 }
 
 /// Passes the real roots of a·τ² + b·τ + c (a linear or constant polynomial included) to
@@ -110,19 +119,58 @@ fn sphere_polynomial<T: Real>(x0: Vec3<T>, d: Vec3<T>, center: Vec3<T>, r: T) ->
 }
 
 /// `true` if the ball (c, r) can meet some segment between the balls `a` and `b`: every such
-/// segment lies in the convex hull of the two balls, which lies within distance max(r_a, r_b) of
-/// the segment between their centres.
+/// segment lies in the convex hull of the two balls (a round cone), so the test is the exact
+/// distance from c to that hull against r (with a relative slack of `GEOMETRY_TOLERANCE`). A
+/// ball of radius zero is a point: the hull is then the cone of segments from it.
+/// Without the `closed-form` feature (embedded builds, where flash counts) the hull is replaced
+/// by the looser tube of radius max(r_a, r_b) around the segment between the centres.
 #[inline]
 pub(crate) fn ball_may_cut_pair<T: Real>(c: Vec3<T>, r: T, a: &Ball<T>, b: &Ball<T>) -> bool {
-    let reach = r + a.radius.max(b.radius);
-    distance_point_segment(c, a.center, b.center) <= reach * (T::ONE + T::GEOMETRY_TOLERANCE)
+    let scale = r + a.radius + b.radius + (b.center - a.center).norm();
+    #[cfg(feature = "closed-form")]
+    let distance = distance_to_hull_of_balls(c, a, b);
+    #[cfg(not(feature = "closed-form"))]
+    let distance = distance_point_segment(c, a.center, b.center) - a.radius.max(b.radius);
+    distance <= r + scale * T::GEOMETRY_TOLERANCE
 }
 
+#[cfg(not(feature = "closed-form"))]
 fn distance_point_segment<T: Real>(c: Vec3<T>, a: Vec3<T>, b: Vec3<T>) -> T {
     let d = b - a;
     let dd = d.norm2();
     let tau = if dd > T::ZERO { ((c - a).dot(d) / dd).max(T::ZERO).min(T::ONE) } else { T::ZERO };
     (c - (a + d.scale(tau))).norm()
+}
+
+/// Distance from x to the convex hull of two balls (zero inside; exact). The hull is a cone
+/// frustum closed by the two spherical caps; in the plane of its axis and x, with `axial` and
+/// `radial` the coordinates of x from a's centre, the frustum's side is the line at slope
+/// (r_a − r_b)/h tangent to both circles.
+#[cfg(any(feature = "closed-form", test))]
+fn distance_to_hull_of_balls<T: Real>(x: Vec3<T>, a: &Ball<T>, b: &Ball<T>) -> T {
+    let axis = b.center - a.center;
+    let h = axis.norm();
+    let (ra, rb) = (a.radius, b.radius);
+    let to_a = x - a.center;
+    if !(h > (ra - rb).abs()) {
+        // One ball contains the other (or their centres coincide).
+        let (big, radius) = if ra >= rb { (a.center, ra) } else { (b.center, rb) };
+        return ((x - big).norm() - radius).max(T::ZERO);
+    }
+    let unit = axis.scale(T::ONE / h);
+    let axial = to_a.dot(unit);
+    let radial = (to_a - unit.scale(axial)).norm();
+    let slope = (ra - rb) / h;
+    let cosine = (T::ONE - slope * slope).max(T::ZERO).sqrt();
+    let along_side = cosine * axial - slope * radial;
+    let distance = if along_side < T::ZERO {
+        to_a.norm() - ra
+    } else if along_side > cosine * h {
+        (x - b.center).norm() - rb
+    } else {
+        cosine * radial + slope * axial - ra
+    };
+    distance.max(T::ZERO)
 }
 
 /// `true` if the signed offset n·(o − x) of point x from the plane through o is zero up to rounding.
@@ -163,6 +211,35 @@ impl<T: Real> Occluder<T> for Sphere<T> {
     }
     fn may_block_between(&self, a: &Ball<T>, b: &Ball<T>) -> bool {
         ball_may_cut_pair(self.center, self.radius, a, b)
+    }
+    /// Every segment from p into ball b crosses the sphere when b's cone from p (half-angle β,
+    /// sin β = r_b/|c_b − p|) lies inside the sphere's tangent cone (half-angle α,
+    /// sin α = R/|c − p|) with margin, θ + β < α for the angle θ between the axes (compared
+    /// through cosines, no trigonometry), and b's nearest point lies beyond the tangent length
+    /// √(|c − p|² − R²), past which every ray inside the tangent cone has entered the sphere.
+    #[cfg(feature = "closed-form")]
+    fn hides_ball_from(&self, p: Vec3<T>, b: &Ball<T>) -> bool {
+        let m = self.center - p;
+        let d = b.center - p;
+        let (m2, d2) = (m.norm2(), d.norm2());
+        let (r2, rb2) = (self.radius * self.radius, b.radius * b.radius);
+        if !(m2 > r2 && d2 > rb2) {
+            return false;
+        }
+        let (dm, dd) = (m2.sqrt(), d2.sqrt());
+        let tangent = (m2 - r2).sqrt();
+        // A relative margin far above rounding: a point this close to the boundary is left to
+        // the exact computation.
+        let margin = T::GEOMETRY_TOLERANCE.sqrt();
+        if !(dd - b.radius > tangent * (T::ONE + margin)) {
+            return false;
+        }
+        let cos_theta = m.dot(d) / (dm * dd);
+        let sin_theta = (T::ONE - cos_theta * cos_theta).max(T::ZERO).sqrt();
+        let (sin_beta, cos_beta) = (b.radius / dd, (T::ONE - rb2 / d2).max(T::ZERO).sqrt());
+        let cos_alpha = tangent / dm;
+        // θ + β < α ⇔ cos(θ + β) > cos α, with θ + β < π (θ > π/2 fails anyway).
+        cos_theta > T::ZERO && cos_theta * cos_beta - sin_theta * sin_beta > cos_alpha * (T::ONE + margin) + margin
     }
     /// With w = q − p and m = c − p the segment meets the sphere iff its direction lies in the
     /// tangent cone ((m·w)² ≥ (|m|² − R²)|w|²), in front of p (m·w > 0), and it reaches the
@@ -392,6 +469,13 @@ impl<T: Real> Occluder<T> for AnyOccluder<T> {
             Self::Cylinder(o) => o.line_polynomials(p, origin, direction, out),
         }
     }
+    #[cfg(feature = "closed-form")]
+    fn hides_ball_from(&self, p: Vec3<T>, b: &Ball<T>) -> bool {
+        match self {
+            Self::Sphere(o) => o.hides_ball_from(p, b),
+            _ => false,
+        }
+    }
 }
 
 /// No occluder.
@@ -425,6 +509,10 @@ impl<T: Real, O: Occluder<T> + ?Sized> Occluder<T> for &O {
     fn line_polynomials(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut([T; 3])) -> bool {
         (**self).line_polynomials(p, origin, direction, out)
     }
+    #[cfg(feature = "closed-form")]
+    fn hides_ball_from(&self, p: Vec3<T>, b: &Ball<T>) -> bool {
+        (**self).hides_ball_from(p, b)
+    }
 }
 
 impl<T: Real, O: Occluder<T>> Occluder<T> for [O] {
@@ -437,6 +525,10 @@ impl<T: Real, O: Occluder<T>> Occluder<T> for [O] {
     #[cfg(feature = "closed-form")]
     fn line_polynomials(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut([T; 3])) -> bool {
         self.iter().all(|o| o.line_polynomials(p, origin, direction, out))
+    }
+    #[cfg(feature = "closed-form")]
+    fn hides_ball_from(&self, p: Vec3<T>, b: &Ball<T>) -> bool {
+        self.iter().any(|o| o.hides_ball_from(p, b))
     }
 }
 
@@ -451,6 +543,10 @@ impl<T: Real, O: Occluder<T>, const N: usize> Occluder<T> for [O; N] {
     fn line_polynomials(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut([T; 3])) -> bool {
         self.iter().all(|o| o.line_polynomials(p, origin, direction, out))
     }
+    #[cfg(feature = "closed-form")]
+    fn hides_ball_from(&self, p: Vec3<T>, b: &Ball<T>) -> bool {
+        self.as_slice().hides_ball_from(p, b)
+    }
 }
 
 impl<T: Real, O: Occluder<T>, const N: usize> Occluder<T> for heapless::Vec<O, N> {
@@ -463,6 +559,10 @@ impl<T: Real, O: Occluder<T>, const N: usize> Occluder<T> for heapless::Vec<O, N
     #[cfg(feature = "closed-form")]
     fn line_polynomials(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut([T; 3])) -> bool {
         self.iter().all(|o| o.line_polynomials(p, origin, direction, out))
+    }
+    #[cfg(feature = "closed-form")]
+    fn hides_ball_from(&self, p: Vec3<T>, b: &Ball<T>) -> bool {
+        self.as_slice().hides_ball_from(p, b)
     }
 }
 
@@ -477,6 +577,10 @@ impl<T: Real, O: Occluder<T>> Occluder<T> for Option<O> {
     fn line_polynomials(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut([T; 3])) -> bool {
         self.as_ref().is_none_or(|o| o.line_polynomials(p, origin, direction, out))
     }
+    #[cfg(feature = "closed-form")]
+    fn hides_ball_from(&self, p: Vec3<T>, b: &Ball<T>) -> bool {
+        self.as_ref().is_some_and(|o| o.hides_ball_from(p, b))
+    }
 }
 
 impl<T: Real, A: Occluder<T>, B: Occluder<T>> Occluder<T> for (A, B) {
@@ -489,6 +593,10 @@ impl<T: Real, A: Occluder<T>, B: Occluder<T>> Occluder<T> for (A, B) {
     #[cfg(feature = "closed-form")]
     fn line_polynomials(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut([T; 3])) -> bool {
         self.0.line_polynomials(p, origin, direction, out) && self.1.line_polynomials(p, origin, direction, out)
+    }
+    #[cfg(feature = "closed-form")]
+    fn hides_ball_from(&self, p: Vec3<T>, b: &Ball<T>) -> bool {
+        self.0.hides_ball_from(p, b) || self.1.hides_ball_from(p, b)
     }
 }
 
@@ -504,6 +612,10 @@ impl<T: Real, A: Occluder<T>, B: Occluder<T>, C: Occluder<T>> Occluder<T> for (A
         self.0.line_polynomials(p, origin, direction, out)
             && self.1.line_polynomials(p, origin, direction, out)
             && self.2.line_polynomials(p, origin, direction, out)
+    }
+    #[cfg(feature = "closed-form")]
+    fn hides_ball_from(&self, p: Vec3<T>, b: &Ball<T>) -> bool {
+        self.0.hides_ball_from(p, b) || self.1.hides_ball_from(p, b) || self.2.hides_ball_from(p, b)
     }
 }
 
@@ -681,5 +793,81 @@ mod tests {
         assert!(!s.may_block_between(&a, &b));
         assert!(far
             .may_block_between(&Ball { center: p, radius: 0.5 }, &Ball { center: vec3(0.0, 13.0, 0.0), radius: 0.1 }));
+    }
+
+    /// A small deterministic generator for the geometric tests (xorshift64*), values in [-1, 1).
+    struct Lcg(u64);
+    impl Lcg {
+        fn next(&mut self) -> f64 {
+            self.0 ^= self.0 >> 12;
+            self.0 ^= self.0 << 25;
+            self.0 ^= self.0 >> 27;
+            let x = self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11;
+            2.0 * (x as f64 / (1u64 << 53) as f64) - 1.0
+        }
+        fn vec(&mut self, scale: f64) -> Vec3<f64> {
+            vec3(self.next() * scale, self.next() * scale, self.next() * scale)
+        }
+    }
+
+    /// The hull of two balls is the union of the balls centred on the segment between their
+    /// centres with linearly interpolated radii: an independent way to get the distance.
+    #[test]
+    fn hull_distance_matches_union_of_interpolated_balls() {
+        let mut rng = Lcg(0x9e37_79b9_7f4a_7c15);
+        let mut inside = 0;
+        for case in 0..2000 {
+            let a = Ball { center: rng.vec(3.0), radius: if case % 5 == 0 { 0.0 } else { 1.0 + rng.next() } };
+            let b = Ball { center: rng.vec(3.0), radius: 1.0 + rng.next() };
+            let x = rng.vec(3.0);
+            let mut brute = f64::INFINITY;
+            for k in 0..=20_000 {
+                let l = f64::from(k) / 20_000.0;
+                let c = a.center.scale(1.0 - l) + b.center.scale(l);
+                let r = a.radius * (1.0 - l) + b.radius * l;
+                brute = brute.min(((x - c).norm() - r).max(0.0));
+            }
+            let d = distance_to_hull_of_balls(x, &a, &b);
+            // The λ grid overestimates the minimum by at most (step · slope)² scale.
+            assert!(d <= brute + 1e-12, "case {case}: {d} > {brute}");
+            assert!(brute - d <= 1e-6, "case {case}: {d} vs {brute}");
+            inside += usize::from(d == 0.0);
+        }
+        assert!(inside > 50 && inside < 1900, "cases inside the hull: {inside}");
+    }
+
+    /// Whenever the sphere claims to hide a ball from p, every probed segment from p into the
+    /// ball (surface and interior points) is blocked; and it does claim so in many cases.
+    #[test]
+    #[cfg(feature = "closed-form")]
+    fn sphere_hides_ball_only_when_every_segment_is_blocked() {
+        let mut rng = Lcg(0x1234_5678_9abc_def1);
+        let sphere = Sphere::outer(o(), 1.0).unwrap();
+        let mut hidden = 0;
+        for case in 0..4000 {
+            // p outside, b roughly behind the sphere as seen from p.
+            let p = rng.vec(1.0) + vec3(0.0, 0.0, 2.0 + 2.0 * rng.next().abs());
+            let behind = (o() - p).scale(1.0 + 2.0 * rng.next().abs());
+            let b = Ball { center: o() + behind + rng.vec(0.7), radius: 0.6 * rng.next().abs() };
+            if !sphere.hides_ball_from(p, &b) {
+                continue;
+            }
+            hidden += 1;
+            for _ in 0..200 {
+                let u = rng.vec(1.0);
+                let dir = if u.norm() > 1e-9 { u.scale(1.0 / u.norm()) } else { vec3(1.0, 0.0, 0.0) };
+                for f in [1.0, rng.next().abs()] {
+                    let q = b.center + dir.scale(b.radius * f);
+                    assert!(sphere.blocks(p, q), "case {case}: {p:?} -> {q:?} not blocked");
+                }
+            }
+        }
+        assert!(hidden > 200, "hidden in only {hidden} cases");
+        // Not hidden: p inside, a ball overlapping the tangent cone's edge, a ball in front.
+        let b = Ball { center: vec3(0.0, 0.0, -3.0), radius: 0.1 };
+        assert!(sphere.hides_ball_from(vec3(0.0, 0.0, 3.0), &b));
+        assert!(!sphere.hides_ball_from(vec3(0.0, 0.0, 0.5), &b));
+        assert!(!sphere.hides_ball_from(vec3(0.0, 0.0, 3.0), &Ball { center: vec3(1.9, 0.0, -3.0), radius: 0.5 }));
+        assert!(!sphere.hides_ball_from(vec3(0.0, 0.0, 3.0), &Ball { center: vec3(0.0, 0.0, 1.5), radius: 0.1 }));
     }
 }

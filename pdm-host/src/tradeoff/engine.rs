@@ -19,8 +19,8 @@
 //! thread count.
 
 use pdm_kernel::{
-    adaptive_exchange, boundary_exchange_counted, classify_near, exchange, pair_exchange, touching_exchange, Adaptive,
-    Adjacency, Occluder, PairSettings, Patch, PatchSamples, PdmError, Real, Surface, MAX_ORDER,
+    adaptive_exchange, exchange, Adaptive, Occluder, PairSettings, Patch, PatchSamples, PdmError, Real, Surface,
+    MAX_ORDER,
 };
 use rayon::prelude::*;
 
@@ -269,12 +269,11 @@ where
     Ok(Solution { values, evaluations })
 }
 
-/// [`pair_exchange`] with `PairSettings { order, singular_order: order, boundaries: true }`,
-/// dispatched here as the kernel does (`pair.rs`) but with the counting variants of the same
-/// kernel functions: (A_a F_{a→b}, evaluations). The test `pair_counted_is_pair_exchange` checks
-/// that the value is `pair_exchange`'s bit for bit. Counted: kernel evaluations and visibility
-/// probes (`boundary_exchange_counted`), order⁴ for the straddle check and for a plain sum,
-/// 6·order⁴ for a shared edge, 4·order⁴ for a shared vertex.
+/// `pdm_kernel::pair_exchange_counted` with `PairSettings { order, singular_order: order,
+/// boundaries: true }`: (A_a F_{a→b}, evaluations), as the kernel counts them (kernel
+/// evaluations and visibility probes on the boundary path, order⁴ for the straddle check and
+/// for a plain sum, 6·order⁴ for a shared edge, 4·order⁴ for a shared vertex). The test
+/// `pair_counted_is_pair_exchange` checks that the value is `pair_exchange`'s bit for bit.
 pub fn pair_counted<T, SA, SB, O, const CAP: usize>(
     a: &Patch<'_, T, SA>,
     b: &Patch<'_, T, SB>,
@@ -287,58 +286,6 @@ where
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
-    let p4 = (order as u64).pow(4);
-    let (adjacency, gap) = classify_near(a, b);
-    match adjacency {
-        Adjacency::SharedEdge { .. } => Ok((touching_exchange(a, b, adjacency, gap, order, occluders)?, 6 * p4)),
-        Adjacency::SharedVertex { .. } => Ok((touching_exchange(a, b, adjacency, gap, order, occluders)?, 4 * p4)),
-        Adjacency::Identical => {
-            let settings = PairSettings { order, singular_order: order, boundaries: true };
-            let q = (order * (order + 1)) as u64;
-            Ok((pair_exchange::<T, SA, SB, O, CAP>(a, b, settings, occluders)?, q * q))
-        }
-        Adjacency::Separate => {
-            let sa = PatchSamples::<T, CAP>::new(a, order)?;
-            let sb = PatchSamples::<T, CAP>::new(b, order)?;
-            if occluders.may_block_between(&sa.bounds(), &sb.bounds()) {
-                // The kernel splits the outer patch under a possible occluder.
-                let (mut total, mut n) = (T::ZERO, 0u64);
-                let r = a.rect();
-                let m = pdm_kernel::pair::OCCLUDED_OUTER_SPLIT;
-                for k in 0..m * m {
-                    let child = Patch::new(a.surface(), r.cell(k / m, k % m, m, m))?;
-                    let (v, c) = boundary_exchange_counted::<T, SA, SB, O, CAP>(&child, b, order, occluders)?;
-                    total += v;
-                    n = n.saturating_add(c);
-                }
-                Ok((total, n))
-            } else if straddles_curvature_cut(&sa, &sb) {
-                let (v, c) = boundary_exchange_counted::<T, SA, SB, (), CAP>(a, b, order, &())?;
-                Ok((v, c.saturating_add(p4)))
-            } else {
-                Ok((exchange(&sa, &sb, &())?, 2 * p4))
-            }
-        }
-    }
-}
-
-/// `true` if some sample pairs pass the two-sided curvature test and others do not (the
-/// kernel's `adaptive::straddles_curvature_cut`, which is crate-private).
-fn straddles_curvature_cut<T: Real, const CA: usize, const CB: usize>(
-    a: &PatchSamples<T, CA>,
-    b: &PatchSamples<T, CB>,
-) -> bool {
-    let (mut visible, mut hidden) = (false, false);
-    for sa in a.iter() {
-        for sb in b.iter() {
-            let e = sb.point - sa.point;
-            let v = sa.unit_normal.dot(e) > T::ZERO && sb.unit_normal.dot(e) < T::ZERO;
-            visible |= v;
-            hidden |= !v;
-            if visible && hidden {
-                return true;
-            }
-        }
-    }
-    false
+    let settings = PairSettings { order, singular_order: order, boundaries: true };
+    pdm_kernel::pair_exchange_counted::<T, SA, SB, O, CAP>(a, b, settings, occluders)
 }
