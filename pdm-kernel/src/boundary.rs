@@ -127,6 +127,8 @@ where
         use_occluders,
         occluders,
         count: &count,
+        scratch: core::cell::RefCell::new(LineScratch::new()),
+        signature_line: core::cell::RefCell::new(Line::new()),
     };
     let mut total = T::ZERO;
     for sample in outer.iter() {
@@ -240,6 +242,10 @@ struct Inner<'x, T: Real, SB: ?Sized, O: ?Sized> {
     use_occluders: bool,
     occluders: &'x O,
     count: &'x core::cell::Cell<u64>,
+    /// Buffers of [`Inner::line`] in closed form.
+    scratch: core::cell::RefCell<LineScratch<T>>,
+    /// The line [`Inner::line_signature`] computes into.
+    signature_line: core::cell::RefCell<Line<T>>,
 }
 
 impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB, O> {
@@ -303,9 +309,20 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
             let (q, nq) = self.surface.point_and_normal(t, s);
             self.visible(p, np, q, nq)
         };
-        let mut polys = Polys::new();
-        if self.line_polys(p, np, s, &mut polys) && closed_form_line(polys.used(), r.t0, r.t1, &vis_at, line) {
-            return Ok(());
+        if self.affine.is_some() {
+            // Reused buffers (zeroing them on every line cost ≈ 6 % of the run time); a fresh
+            // set if they are in use (never: lines are not computed re-entrantly).
+            let mut fresh = None;
+            let mut borrowed = self.scratch.try_borrow_mut();
+            let scratch: &mut LineScratch<T> = match borrowed.as_deref_mut() {
+                Ok(scratch) => scratch,
+                Err(_) => fresh.insert(LineScratch::new()),
+            };
+            let LineScratch { polys, candidates } = scratch;
+            if self.line_polys(p, np, s, polys) && closed_form_line(polys.used(), r.t0, r.t1, &vis_at, candidates, line)
+            {
+                return Ok(());
+            }
         }
         // Bracket visibility changes along the line, refine each by bisection.
         line.n = 0;
@@ -322,8 +339,13 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
     /// polynomials make the breaks); an error counts as its own structure (it is reported
     /// again when the line is integrated).
     fn line_signature(&self, p: Vec3<T>, np: Vec3<T>, s: T) -> (usize, bool, u64) {
-        let mut line = Line::new();
-        match self.line(p, np, s, &mut line) {
+        let mut fresh = None;
+        let mut borrowed = self.signature_line.try_borrow_mut();
+        let line: &mut Line<T> = match borrowed.as_deref_mut() {
+            Ok(line) => line,
+            Err(_) => fresh.insert(Line::new()),
+        };
+        match self.line(p, np, s, line) {
             Ok(()) => (line.n, line.first_visible, line.ids),
             Err(_) => (usize::MAX, false, 0),
         }
@@ -355,27 +377,35 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
         if !ok {
             return Err(PdmError::InvalidResult);
         }
-        let mut candidates = [T::ZERO; 4 * MAX_BREAKS];
+        // Candidates with the polynomial they come from; an overflow makes every sub-interval
+        // count as possibly crossed (see below).
+        let mut candidates = [(T::ZERO, 0usize); 4 * MAX_BREAKS];
         let mut nc = 0usize;
+        let mut overflow = false;
         // Candidates just outside b count too: a singular point close beyond an edge slows the
         // rule on the piece at that edge (it is graded towards it).
         let reach = T::HALF * T::HALF;
-        let mut add = |x: T| {
-            if x > -reach && x < T::ONE + reach {
-                if let Some(slot) = candidates.get_mut(nc) {
-                    *slot = r.s0 + h * x;
-                    nc += 1;
-                }
-            }
-        };
         let fit = |v0: T, vh: T, v1: T| -> [T; 3] {
             let four = T::TWO * T::TWO;
             [v0, four * vh - T::from_f64(3.0) * v0 - v1, T::TWO * (v1 + v0) - four * vh]
         };
-        for ((&[a0, b0, k0], &[ah, bh, kh]), &[a1, b1, k1]) in p0.used().iter().zip(ph.used()).zip(p1.used()) {
-            let qa = fit(a0, ah, a1);
-            let qb = fit(b0, bh, b1);
-            let qc = fit(k0, kh, k1);
+        // Each polynomial's coefficients (a, b, c) as quadratics in x.
+        let mut fits = [[[T::ZERO; 3]; 3]; MAX_POLYS];
+        let polys = p0.used().iter().zip(ph.used()).zip(p1.used());
+        for (id, (((&[a0, b0, k0], &[ah, bh, kh]), &[a1, b1, k1]), slot)) in polys.zip(fits.iter_mut()).enumerate() {
+            let (qa, qb, qc) = (fit(a0, ah, a1), fit(b0, bh, b1), fit(k0, kh, k1));
+            *slot = [qa, qb, qc];
+            let mut add = |x: T| {
+                if x > -reach && x < T::ONE + reach {
+                    match candidates.get_mut(nc) {
+                        Some(c) => {
+                            *c = (r.s0 + h * x, id);
+                            nc += 1;
+                        }
+                        None => overflow = true,
+                    }
+                }
+            };
             // A root crossing the t-edges: P(t_edge; x) = a(x) t² + b(x) t + c(x), coefficient by
             // coefficient in x.
             for t in [r.t0, r.t1] {
@@ -400,15 +430,47 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
                 roots_in_interval(&d, -reach, T::ONE + reach, &mut add);
             }
         }
-        let used = candidates.get_mut(..nc).unwrap_or_default();
-        sort(used);
+        let fits = fits.get(..p0.n).unwrap_or_default();
+        let candidates = candidates.get_mut(..nc).unwrap_or_default();
+        // Sort by position (insertion sort: few elements, no allocation).
+        for i in 1..candidates.len() {
+            let mut j = i;
+            while j > 0 {
+                let (Some(&x), Some(&y)) = (candidates.get(j - 1), candidates.get(j)) else { break };
+                if x.0 > y.0 {
+                    candidates.swap(j - 1, j);
+                    j -= 1;
+                } else {
+                    break;
+                }
+            }
+        }
+        let candidates = &*candidates;
+        // How many polynomials have a root inside (t0, t1) somewhere in [from, hi]: those with
+        // one at `from`, and those with a candidate inside (a root enters the line's range only
+        // across a t-edge or as a double root, both candidates).
+        let with_roots_inside = |from: T, hi: T| -> usize {
+            let x = (from - r.s0) / h;
+            let mut count = 0;
+            for (id, [qa, qb, qc]) in fits.iter().enumerate() {
+                let mut inside = candidates.iter().any(|&(c, i)| i == id && c > from && c < hi);
+                if !inside {
+                    let at = |q: &[T; 3]| horner(q, x);
+                    crate::visibility::polynomial_roots(at(qa), at(qb), at(qc), &mut |t| {
+                        inside |= t > r.t0 && t < r.t1;
+                    });
+                }
+                count += usize::from(inside);
+            }
+            count
+        };
         // Keep the candidates where the line structure actually changes.
         let delta = h * T::EPSILON.sqrt();
         let mut kept_at = [T::ZERO; MAX_BREAKS + 2];
         let mut kept = 0usize;
         let mut last = r.s0 - h;
         let mut outside: Outside<T> = (None, None);
-        for &c in used.iter() {
+        for &(c, _) in candidates {
             if c - last <= delta {
                 continue;
             }
@@ -426,21 +488,21 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
                 }
             }
         }
-        // Anything else between them: bracket and bisect.
-        let signature = |s: T| self.line_signature(p, np, s);
+        // Anything else between them (two polynomials' roots crossing): bracket and bisect,
+        // where at least two polynomials have roots on the lines.
         let mut lo = r.s0;
         for k in 0..=kept {
             let next = if k < kept { kept_at.get(k).copied() } else { None };
             let hi = next.map_or(r.s1, |c| c - delta);
             let from = if k == 0 { lo } else { lo + delta };
-            if hi > from {
+            if hi > from && (overflow || with_roots_inside(from, hi) >= 2) {
                 let span = (hi - from) / h;
                 // Probes in proportion to the sub-interval's share of [s0, s1] (at least 3).
                 let mut probes = 3;
                 while probes < self.probes && T::from_usize(probes) < T::from_usize(self.probes) * span {
                     probes += 1;
                 }
-                locate_changes(&signature, from, hi, probes, out, n)?;
+                locate_changes(&|s: T| self.line_signature(p, np, s), from, hi, probes, out, n)?;
             }
             lo = next.unwrap_or(r.s1);
         }
@@ -628,14 +690,32 @@ impl<T: Real> Line<T> {
     }
 }
 
+/// Buffers for computing one line in closed form, kept between lines.
+struct LineScratch<T> {
+    polys: Polys<T>,
+    candidates: [(T, u64); MAX_CANDIDATES],
+}
+
+impl<T: Real> LineScratch<T> {
+    fn new() -> Self {
+        Self { polys: Polys::new(), candidates: [(T::ZERO, 0u64); MAX_CANDIDATES] }
+    }
+}
+
 /// Most candidate switches gathered on one line.
 const MAX_CANDIDATES: usize = 2 * MAX_POLYS;
 
 /// The visibility structure of the line t ∈ [t0, t1] from its polynomials: the candidate
 /// switches are their real roots; each piece between consecutive candidates is classified by
 /// the exact test at its midpoint, and equal neighbours merged. `false` if there are too many.
-fn closed_form_line<T: Real>(polys: &[[T; 3]], t0: T, t1: T, vis_at: &impl Fn(T) -> bool, line: &mut Line<T>) -> bool {
-    let mut candidates = [(T::ZERO, 0u64); MAX_CANDIDATES];
+fn closed_form_line<T: Real>(
+    polys: &[[T; 3]],
+    t0: T,
+    t1: T,
+    vis_at: &impl Fn(T) -> bool,
+    candidates: &mut [(T, u64); MAX_CANDIDATES],
+    line: &mut Line<T>,
+) -> bool {
     let mut n = 0usize;
     let mut overflow = false;
     for (id, &[a, b, c]) in polys.iter().enumerate() {

@@ -478,6 +478,8 @@ where
     if gap >= T::MAX {
         return Err(PdmError::Degenerate);
     }
+    // Every sample pair would test the occluders: skip them when none can cut the pair.
+    let occluded = occluders.may_block_between(&a.enclosing_ball(), &b.enclosing_ball());
     // A gap at the level of rounding is no gap (and a subnormal one would make hundreds of
     // graded intervals).
     let gap = if gap > T::from_f64(64.0) * T::EPSILON && gap.is_finite() { gap } else { T::ZERO };
@@ -494,7 +496,11 @@ where
             ];
             let (ext, r0) = extents(lengths);
             let g = if r0 > T::ZERO { gap * scale / r0 } else { gap };
-            edge_sum(&la, &lb, &rule, occluders, ext, at(&lengths, 0), g, fold)
+            if occluded {
+                edge_sum(&la, &lb, &rule, occluders, ext, at(&lengths, 0), g, fold)
+            } else {
+                edge_sum(&la, &lb, &rule, &(), ext, at(&lengths, 0), g, fold)
+            }
         }
         Adjacency::SharedVertex { a: ma, b: mb } => {
             let (la, lb) = (Local { patch: a, map: ma }, Local { patch: b, map: mb });
@@ -503,7 +509,11 @@ where
                 [line_length(&la, o, x), line_length(&la, o, y), line_length(&lb, o, x), line_length(&lb, o, y)];
             let (ext, r0) = extents(lengths);
             let g = if r0 > T::ZERO { gap * scale / r0 } else { gap };
-            vertex_sum(&la, &lb, &rule, occluders, ext, g)
+            if occluded {
+                vertex_sum(&la, &lb, &rule, occluders, ext, g)
+            } else {
+                vertex_sum(&la, &lb, &rule, &(), ext, g)
+            }
         }
         Adjacency::Separate | Adjacency::Identical => return Err(PdmError::Degenerate),
     };
