@@ -114,3 +114,119 @@ fn adaptive_estimates_across_the_sphere_shadow() {
         }
     }
 }
+
+/// Point-to-polygon factor of a differential area at `p` with unit normal `n` (Lambert's
+/// contour formula, F = |Σ_i γ_i n·ĝ_i| / 2π with γ_i the angle the edge subtends at p and ĝ_i
+/// the unit normal of the plane through p and the edge); the polygon must lie in front of p.
+/// Plain f64 geometry, no kernel code.
+fn point_to_polygon(p: [f64; 3], n: [f64; 3], polygon: &[[f64; 2]], z: f64) -> f64 {
+    let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let cross =
+        |a: [f64; 3], b: [f64; 3]| [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+    let mut sum = 0.0;
+    for (i, v) in polygon.iter().enumerate() {
+        let w = polygon[(i + 1) % polygon.len()];
+        let (r1, r2) = (sub([v[0], v[1], z], p), sub([w[0], w[1], z], p));
+        let c = cross(r1, r2);
+        let norm = dot(c, c).sqrt();
+        if norm == 0.0 {
+            continue;
+        }
+        let angle = norm.atan2(dot(r1, r2));
+        sum += angle * dot(n, c) / norm;
+    }
+    sum.abs() / (2.0 * std::f64::consts::PI)
+}
+
+/// The part of the convex polygon `subject` inside the convex polygon `clip` (both
+/// counter-clockwise), by Sutherland–Hodgman.
+fn clip_polygon(subject: &[[f64; 2]], clip: &[[f64; 2]]) -> Vec<[f64; 2]> {
+    let mut out = subject.to_vec();
+    for (i, a) in clip.iter().enumerate() {
+        let b = clip[(i + 1) % clip.len()];
+        let side = |p: [f64; 2]| (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0]);
+        let input = std::mem::take(&mut out);
+        for (j, &p) in input.iter().enumerate() {
+            let q = input[(j + 1) % input.len()];
+            let (sp, sq) = (side(p), side(q));
+            if sp >= 0.0 {
+                out.push(p);
+            }
+            if (sp >= 0.0) != (sq >= 0.0) {
+                let t = sp / (sp - sq);
+                out.push([p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])]);
+            }
+        }
+        if out.is_empty() {
+            break;
+        }
+    }
+    out
+}
+
+/// A polygonal shadow: a square plate (rotated about the vertical, parallel to b) between a
+/// point above and the unit square b on z = 0. The shadow is the plate's central projection,
+/// its corners fall inside b (two occluder polynomials' roots cross on b's lines there), and
+/// the blocked part of the point factor is the point-to-polygon factor of b ∩ shadow (clipping
+/// and Lambert's contour formula above, no kernel code).
+#[test]
+fn polygonal_shadow_matches_clipping_and_the_contour_formula() {
+    use pdm_kernel::Occluder;
+    let height = 2.0;
+    let top = Parallelogram::new(vec3(-1.0, -1.0, height), vec3(0.0, 3.0, 0.0), vec3(3.0, 0.0, 0.0)).unwrap();
+    let bottom = Parallelogram::new(vec3(0.0, 0.0, 0.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0)).unwrap();
+    let b = Patch::whole(&bottom).unwrap();
+    let square_b = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+    let mut worst: f64 = 0.0;
+    let mut cases = 0;
+    for (angle_deg, half, plate_z) in [(30.0f64, 0.2, 1.0), (10.0, 0.3, 0.7), (45.0, 0.15, 1.4), (72.0, 0.35, 0.5)] {
+        let (c, s) = (angle_deg.to_radians().cos(), angle_deg.to_radians().sin());
+        let center = [0.45, 0.55];
+        // Plate corners (counter-clockwise seen from above), edges rotated by the angle.
+        let corner = |u: f64, v: f64| [center[0] + half * (u * c - v * s), center[1] + half * (u * s + v * c)];
+        let plate = [corner(-1.0, -1.0), corner(1.0, -1.0), corner(1.0, 1.0), corner(-1.0, 1.0)];
+        let (o, e1, e2) = (plate[0], plate[1], plate[3]);
+        let occluder = Parallelogram::new(
+            vec3(o[0], o[1], plate_z),
+            vec3(e1[0] - o[0], e1[1] - o[1], 0.0),
+            vec3(e2[0] - o[0], e2[1] - o[1], 0.0),
+        )
+        .unwrap();
+        for (t, s_) in [(0.45, 0.52), (0.5, 0.5), (0.4, 0.43), (0.52, 0.58)] {
+            let eps = 1e-8;
+            let rect = ParamRect::new(t, t + eps, s_, s_ + eps).unwrap();
+            let cell = Patch::new(&top, rect).unwrap();
+            let area = 9.0 * (rect.t1 - rect.t0) * (rect.s1 - rect.s0);
+            let open = boundary_exchange::<f64, _, _, _, 1024>(&cell, &b, 20, &()).unwrap() / area;
+            let occluded = boundary_exchange::<f64, _, _, _, 1024>(&cell, &b, 20, &occluder).unwrap() / area;
+            let p = top.origin()
+                + top.edge_t().scale((rect.t0 + rect.t1) / 2.0)
+                + top.edge_s().scale((rect.s0 + rect.s1) / 2.0);
+            // Shadow: project each plate corner from p onto z = 0.
+            let k = p.z / (p.z - plate_z);
+            let shadow: Vec<[f64; 2]> =
+                plate.iter().map(|q| [p.x + k * (q[0] - p.x), p.y + k * (q[1] - p.y)]).collect();
+            let visible_shadow = clip_polygon(&shadow, &square_b);
+            let inside = shadow.iter().filter(|q| q.iter().all(|&x| x > 0.0 && x < 1.0)).count();
+            let reference_blocked = point_to_polygon([p.x, p.y, p.z], [0.0, 0.0, -1.0], &visible_shadow, 0.0);
+            let reference_open = point_to_polygon([p.x, p.y, p.z], [0.0, 0.0, -1.0], &square_b, 0.0);
+            // The kernel's own check that the geometry is as intended: the centre is blocked.
+            assert!(occluder.blocks(
+                p,
+                vec3(shadow[0][0] * 0.5 + shadow[2][0] * 0.5, shadow[0][1] * 0.5 + shadow[2][1] * 0.5, 0.0)
+            ));
+            let err_open = (open - reference_open).abs() / reference_open;
+            let err = ((open - occluded) - reference_blocked).abs() / reference_open;
+            println!("angle {angle_deg} half {half} z {plate_z} p ({t}, {s_}): {inside} shadow corners inside b, blocked {:.12e} ref {reference_blocked:.12e}, rel {err:.1e} (open {err_open:.1e})", open - occluded);
+            assert!(err_open < 1e-13, "unoccluded point factor {open} vs {reference_open}");
+            worst = worst.max(err);
+            cases += usize::from(inside >= 1);
+        }
+    }
+    println!("worst {worst:.2e}");
+    assert!(cases >= 12, "shadow corners must fall inside b: {cases} cases");
+    // Measured ≤ 1.1e-15 at order 20 (without the bracketing of root crossings between the
+    // closed-form candidates: 6.5e-4, checked).
+    assert!(worst < 1e-12, "worst relative error {worst:.2e}");
+}
