@@ -37,7 +37,16 @@
 //! converges along each line, but the outer s-level has curves parallel to the t-lines and
 //! costs 10× the time) and is not in this version.
 //!
-//! Cost per outer point: order lines × (a few polynomial roots and ≤ 16 exact visibility tests,
+//! Per outer point p the machinery runs only where it is needed: if no occluder meets the cone
+//! of segments from p to b's bounding ball ([`Occluder::may_block_between`] with p as a ball of
+//! radius zero: the exact distance to the hull of two balls) and a flat b faces p at all four
+//! corners, b gets the plain `order` × `order` rule; if b lies behind p's tangent plane, behind
+//! its own, or inside an occluder's shadow cone (`Occluder::hides_ball_from`), p adds zero.
+//! Where some occluder may cut, the s-level probe sweep (below) runs only on intervals where at
+//! least two polynomials have roots on the lines: a root enters a line's range only at a
+//! candidate, so with fewer no two roots can cross.
+//!
+//! Cost per outer point on the boundary path: order lines × (a few polynomial roots and ≤ 16 exact visibility tests,
 //! or 2·order + 3 probes + ≈ 60 bisection probes per boundary, + order evaluations per visible
 //! piece), plus the s-level search (3 polynomial evaluations, ≤ 2 structure tests per
 //! candidate). No allocation: breakpoints live in fixed-size arrays (at most [`MAX_BREAKS`]

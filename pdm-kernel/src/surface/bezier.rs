@@ -6,7 +6,7 @@ use crate::error::PdmError;
 use crate::real::Real;
 use crate::vec3::{vec3, Vec3};
 
-/// The bicubic Bézier patch g(t, s) = Σᵢ Σⱼ Bᵢ(t) Bⱼ(s) P[i][j], (t, s) ∈ [0, 1]², with the cubic
+/// The bicubic Bézier patch g(t, s) = Σᵢ Σⱼ Bᵢ(t) Bⱼ(s) P\[i\]\[j\], (t, s) ∈ [0, 1]², with the cubic
 /// Bernstein polynomials Bᵢ. Normal ∂g/∂t × ∂g/∂s from the Bernstein derivatives (closed form).
 /// Rows of `control` go along t, columns along s.
 #[derive(Clone, Copy, Debug, PartialEq)]
