@@ -29,6 +29,10 @@ pub struct Values {
     pub sphere_area: Option<f64>,
     /// Face areas (Σ of the patch areas by eq. 12).
     pub face_area: [f64; 6],
+    /// Tolerance mode only: the largest of the kernel's own error estimates over the 21
+    /// factors, each the sum of its patch pairs' estimates relative to the factor
+    /// (`adaptive_exchange`'s `Estimate::error`); `None` in the fixed modes.
+    pub estimated_error: Option<f64>,
 }
 
 /// Wall times of one computation, seconds.
@@ -41,6 +45,10 @@ pub struct Times {
 }
 
 type Face<T> = Parallelogram<T>;
+
+/// Face → face part: exchange sums of the 15 face pairs, the 6 face areas, and the sums of the
+/// kernel's error estimates of the 15 pairs (tolerance mode; zero otherwise).
+type FaceFaceSums<T> = ([T; 15], [T; 6], [T; 15]);
 
 fn kernel(context: &'static str) -> impl Fn(PdmError) -> ValidateError {
     move |error| ValidateError::Kernel { context, error }
@@ -86,19 +94,32 @@ pub fn run_once<T: Real, const CAP: usize>(
     // Part 2: face → face (Table 3), eq. (26), the sphere as occluder.
     progress.stage("face -> face");
     let start = Instant::now();
-    let (face_exchange, face_area) = match cfg.mode {
-        Mode::Paper => paper_face_face::<T, CAP>(cfg, &scene.sphere, &face_patches, progress)?,
+    let (face_exchange, face_area, face_error) = match cfg.mode {
+        Mode::Paper => {
+            let (exchange, area) = paper_face_face::<T, CAP>(cfg, &scene.sphere, &face_patches, progress)?;
+            (exchange, area, [T::ZERO; 15])
+        }
         Mode::Accurate => accurate_face_face::<T, CAP>(cfg, &scene.sphere, &face_patches, progress)?,
     };
     let face_face_seconds = start.elapsed().as_secs_f64();
 
-    let values = derive(part1, &face_exchange, &face_area)?;
+    // The kernel's estimates relative to the exchange they belong to (tolerance mode).
+    let estimated_error = cfg.tolerance.map(|_| {
+        let relative = |e: T, x: T| if x.abs() > T::ZERO { (e / x.abs()).to_f64() } else { e.to_f64() };
+        let faces = face_error.iter().zip(&face_exchange).map(|(&e, &x)| relative(e, x));
+        let sphere = part1.iter().flat_map(|p| p.error.iter().zip(&p.exchange).map(|(&e, &x)| relative(e, x)));
+        faces.chain(sphere).fold(0.0, f64::max)
+    });
+    let mut values = derive(part1, &face_exchange, &face_area)?;
+    values.estimated_error = estimated_error;
     Ok((values, Times { sphere_face: sphere_face_seconds, face_face: face_face_seconds }))
 }
 
 /// Exchange sums per face (Σ A_ps F_ps→pf over the face's patches) and the sphere's area.
 struct SpherePart<T> {
     exchange: [T; 6],
+    /// Σ of the kernel's error estimates per face (tolerance mode; zero otherwise).
+    error: [T; 6],
     sphere_area: T,
     face_area: [T; 6],
 }
@@ -150,6 +171,7 @@ fn derive<T: Real>(
         face_sum,
         sphere_area,
         face_area: face_area.map(Real::to_f64),
+        estimated_error: None,
     })
 }
 
@@ -209,7 +231,12 @@ fn paper_sphere_face<T: Real, const CAP: usize>(
     for (a, f) in face_area.iter_mut().zip(&fs) {
         *a = total_area(f);
     }
-    Ok(SpherePart { exchange: chunk_sums(&partial, ss.len()), sphere_area: total_area(&ss), face_area })
+    Ok(SpherePart {
+        exchange: chunk_sums(&partial, ss.len()),
+        error: [T::ZERO; 6],
+        sphere_area: total_area(&ss),
+        face_area,
+    })
 }
 
 /// Paper mode, part 2: eq. (26) with plain eq. (16) sums, the sphere as occluder; edge-adjacent
@@ -257,7 +284,7 @@ fn accurate_pair<T, SA, SB, O, const CAP: usize>(
     a: &Patch<'_, T, SA>,
     b: &Patch<'_, T, SB>,
     occluders: &O,
-) -> Result<T, PdmError>
+) -> Result<(T, T), PdmError>
 where
     T: Real,
     SA: Surface<T> + ?Sized,
@@ -267,9 +294,9 @@ where
     match cfg.tolerance {
         Some(tol) => {
             let settings = Adaptive { tolerance: T::from_f64(tol), max_order: ADAPTIVE_MAX_ORDER, max_depth: 6 };
-            adaptive_exchange::<T, SA, SB, O, CAP>(a, b, settings, occluders).map(|e| e.value)
+            adaptive_exchange::<T, SA, SB, O, CAP>(a, b, settings, occluders).map(|e| (e.value, e.error))
         }
-        None => pair_exchange::<T, SA, SB, O, CAP>(a, b, settings(cfg), occluders),
+        None => pair_exchange::<T, SA, SB, O, CAP>(a, b, settings(cfg), occluders).map(|v| (v, T::ZERO)),
     }
 }
 
@@ -304,21 +331,25 @@ fn accurate_sphere_face<T: Real, const CAP: usize>(
     let partial = tasks
         .par_iter()
         .map(|&(ps, face)| {
-            let mut acc = T::ZERO;
+            let (mut acc, mut err) = (T::ZERO, T::ZERO);
             for pf in face {
-                acc +=
+                let (v, e) =
                     accurate_pair::<T, _, _, _, CAP>(cfg, ps, pf, &()).map_err(kernel("sphere patch -> face patch"))?;
+                acc += v;
+                err += e;
             }
             progress.advance(1);
-            Ok(acc)
+            Ok((acc, err))
         })
-        .collect::<Result<Vec<T>, ValidateError>>()?;
+        .collect::<Result<Vec<(T, T)>, ValidateError>>()?;
+    let (values, errors): (Vec<T>, Vec<T>) = partial.into_iter().unzip();
     let mut face_area = [T::ZERO; 6];
     for (a, f) in face_area.iter_mut().zip(face_patches) {
         *a = areas(f, cfg.order)?;
     }
     Ok(SpherePart {
-        exchange: chunk_sums(&partial, sphere_patches.len()),
+        exchange: chunk_sums(&values, sphere_patches.len()),
+        error: chunk_sums(&errors, sphere_patches.len()),
         sphere_area: areas(sphere_patches, cfg.order)?,
         face_area,
     })
@@ -331,7 +362,7 @@ fn accurate_face_face<T: Real, const CAP: usize>(
     sphere: &Option<Sphere<T>>,
     face_patches: &[Vec<Patch<'_, T, Face<T>>>],
     progress: &dyn Progress,
-) -> Result<([T; 15], [T; 6]), ValidateError> {
+) -> Result<FaceFaceSums<T>, ValidateError> {
     let per_pair = cfg.face_grid * cfg.face_grid;
     type Task<'a, 'p, T> = (&'a Patch<'p, T, Face<T>>, &'a [Patch<'p, T, Face<T>>]);
     let mut tasks: Vec<Task<'_, '_, T>> = Vec::new();
@@ -343,18 +374,21 @@ fn accurate_face_face<T: Real, const CAP: usize>(
     let partial = tasks
         .par_iter()
         .map(|&(pa, face_b)| {
-            let mut acc = T::ZERO;
+            let (mut acc, mut err) = (T::ZERO, T::ZERO);
             for pb in face_b {
-                acc += accurate_pair::<T, _, _, _, CAP>(cfg, pa, pb, sphere)
+                let (v, e) = accurate_pair::<T, _, _, _, CAP>(cfg, pa, pb, sphere)
                     .map_err(kernel("face patch -> face patch"))?;
+                acc += v;
+                err += e;
             }
             progress.advance(1);
-            Ok(acc)
+            Ok((acc, err))
         })
-        .collect::<Result<Vec<T>, ValidateError>>()?;
+        .collect::<Result<Vec<(T, T)>, ValidateError>>()?;
+    let (values, errors): (Vec<T>, Vec<T>) = partial.into_iter().unzip();
     let mut face_area = [T::ZERO; 6];
     for (a, f) in face_area.iter_mut().zip(face_patches) {
         *a = areas(f, cfg.order)?;
     }
-    Ok((chunk_sums(&partial, per_pair), face_area))
+    Ok((chunk_sums(&values, per_pair), face_area, chunk_sums(&errors, per_pair)))
 }

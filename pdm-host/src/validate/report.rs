@@ -120,6 +120,7 @@ impl Report {
         m.insert("face_to_sphere".into(), json!(v.face_to_sphere));
         m.insert("face_to_face".into(), pair_object(&v.face_to_face));
         m.insert("face_sum".into(), json!(v.face_sum));
+        m.insert("estimated_error".into(), json!(v.estimated_error));
         m.insert("reference".into(), self.reference_json());
         let mut ff_err = [0.0; 15];
         for ((e, &ours), &re) in ff_err.iter_mut().zip(&v.face_to_face).zip(&r.face_to_face) {
@@ -446,6 +447,16 @@ impl Report {
         ));
         if self.paper.is_some() && self.outcomes.len() == 1 {
             notes.push("p.err: the paper's relative error against our reference.".into());
+        }
+        for o in &self.outcomes {
+            if let Some(e) = o.values.estimated_error {
+                notes.push(format!(
+                    "The kernel's own error estimate ({}): at most {e:.1e} relative on any factor (the \
+                     sum of its patch pairs' estimates; above the tolerance where pairs stopped at the \
+                     subdivision limit).",
+                    o.precision.name()
+                ));
+            }
         }
         notes
     }
