@@ -441,19 +441,7 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
         }
         let fits = fits.get(..p0.n).unwrap_or_default();
         let candidates = candidates.get_mut(..nc).unwrap_or_default();
-        // Sort by position (insertion sort: few elements, no allocation).
-        for i in 1..candidates.len() {
-            let mut j = i;
-            while j > 0 {
-                let (Some(&x), Some(&y)) = (candidates.get(j - 1), candidates.get(j)) else { break };
-                if x.0 > y.0 {
-                    candidates.swap(j - 1, j);
-                    j -= 1;
-                } else {
-                    break;
-                }
-            }
-        }
+        sort_by_position(candidates);
         let candidates = &*candidates;
         // How many polynomials have a root inside (t0, t1) somewhere in [from, hi]: those with
         // one at `from`, and those with a candidate inside (a root enters the line's range only
@@ -743,20 +731,8 @@ fn closed_form_line<T: Real>(
     if overflow {
         return false;
     }
-    // Insertion sort by t.
     let used = candidates.get_mut(..n).unwrap_or_default();
-    for i in 1..used.len() {
-        let mut j = i;
-        while j > 0 {
-            let (Some(&x), Some(&y)) = (used.get(j - 1), used.get(j)) else { break };
-            if x.0 > y.0 {
-                used.swap(j - 1, j);
-                j -= 1;
-            } else {
-                break;
-            }
-        }
-    }
+    sort_by_position(used);
     line.n = 0;
     line.ids = 0;
     let mut lo = t0;
@@ -918,6 +894,23 @@ fn locate_changes<T: Real, K: PartialEq + Copy>(
         prev_v = v;
     }
     Ok(())
+}
+
+/// Insertion sort of (position, tag) pairs by position (few elements, no allocation, no
+/// panics on NaN: NaN never moves).
+fn sort_by_position<T: Real, K: Copy>(xs: &mut [(T, K)]) {
+    for i in 1..xs.len() {
+        let mut j = i;
+        while j > 0 {
+            let (Some(&x), Some(&y)) = (xs.get(j - 1), xs.get(j)) else { break };
+            if x.0 > y.0 {
+                xs.swap(j - 1, j);
+                j -= 1;
+            } else {
+                break;
+            }
+        }
+    }
 }
 
 /// Insertion sort (few elements, no allocation, no panics on NaN: NaN never moves).
