@@ -172,10 +172,7 @@ where
         };
         total += sample.weight * j;
     }
-    let value = total * T::FRAC_1_PI;
-    if !value.is_finite() || value < T::ZERO {
-        return Err(PdmError::InvalidResult);
-    }
+    let value = crate::bounds::exchange(total * T::FRAC_1_PI, outer.area(), inner_samples.area())?;
     Ok((value, count.get()))
 }
 

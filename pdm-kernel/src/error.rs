@@ -32,10 +32,19 @@ pub enum PdmError {
         /// Entries available.
         capacity: usize,
     },
-    /// The computed form factor (or exchange) was not a finite, non-negative number. (A plain
-    /// rule at a low order may exceed 1 for a large, close receiver; that is a quadrature error,
-    /// not refused here.)
+    /// The computed form factor (or exchange) is outside what physics allows: not finite,
+    /// negative, F > 1, or A_a·F_{a→b} > min(A_a, A_b) (beyond a rounding band). A quadrature
+    /// rule that cannot resolve the pair (too close, too thin) gives such values; they are
+    /// refused instead of returned.
     InvalidResult,
+    /// A setting outside its valid range (a tolerance that is not positive and finite, a
+    /// maximum order the kernel cannot use, …).
+    InvalidSetting {
+        /// The setting.
+        name: &'static str,
+        /// What it must be.
+        expected: &'static str,
+    },
 }
 
 impl fmt::Display for PdmError {
@@ -51,7 +60,10 @@ impl fmt::Display for PdmError {
             Self::CapacityExceeded { needed, capacity } => {
                 write!(f, "fixed capacity exceeded: need {needed}, have {capacity}")
             }
-            Self::InvalidResult => f.write_str("form factor is not a finite, non-negative number"),
+            Self::InvalidResult => f.write_str(
+                "form factor outside the physical bounds (not finite, F < 0, F > 1 or A_a*F_ab > min(A_a, A_b))",
+            ),
+            Self::InvalidSetting { name, expected } => write!(f, "invalid setting {name}: must be {expected}"),
         }
     }
 }

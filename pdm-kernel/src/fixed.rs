@@ -81,11 +81,7 @@ where
             total_exchange += exchange(&sa, &sb, occluders)?;
         }
     }
-    let value = total_exchange / total_area;
-    if !value.is_finite() {
-        return Err(PdmError::InvalidResult);
-    }
-    Ok(value)
+    crate::bounds::form_factor(total_exchange / total_area)
 }
 
 /// [`crate::form_factor_between`] at the compile-time order `N` on both patches

@@ -63,11 +63,7 @@ where
     } else {
         pdm_sum::<T, O, CA, CB>(a, b, None)
     };
-    let value = sum * T::FRAC_1_PI;
-    if !value.is_finite() || value < T::ZERO {
-        return Err(PdmError::InvalidResult);
-    }
-    Ok(value)
+    crate::bounds::exchange(sum * T::FRAC_1_PI, a.area(), b.area())
 }
 
 /// F_{a→b} between two sampled patches by eqs. (15)–(16) with the 1/π and Jacobians restored,
@@ -81,11 +77,7 @@ where
     T: Real,
     O: Occluder<T> + ?Sized,
 {
-    let value = exchange(a, b, occluders)? / a.area();
-    if !value.is_finite() {
-        return Err(PdmError::InvalidResult);
-    }
-    Ok(value)
+    crate::bounds::form_factor(exchange(a, b, occluders)? / a.area())
 }
 
 /// F_{a→b} between two patches, sampling both (buffers of capacity `CAP` on the stack: use
@@ -138,11 +130,7 @@ where
     // Use the order-(p+1) area for the normalisation of the symmetric exchange: both copies
     // estimate the same area; take the mean to keep reciprocity exact.
     let e = exchange(&a, &b, occluders)?;
-    let value = e * T::TWO / (a.area() + b.area());
-    if !value.is_finite() {
-        return Err(PdmError::InvalidResult);
-    }
-    Ok(value)
+    crate::bounds::form_factor(e * T::TWO / (a.area() + b.area()))
 }
 
 /// Substructuring, eqs. (25)–(26): F_{A→B} = (1/A_A) Σ_{pa} Σ_{pb} A_pa F_{pa→pb} between the

@@ -40,6 +40,7 @@
 
 pub mod adaptive;
 pub mod boundary;
+mod bounds;
 pub mod dual;
 pub mod error;
 pub mod fixed;

@@ -80,6 +80,24 @@ where
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
+    let (value, count) = dispatch::<T, SA, SB, O, CAP>(a, b, settings, occluders)?;
+    let order = settings.order.max(2);
+    let value = crate::bounds::exchange(value, a.area(order)?, b.area(order)?)?;
+    Ok((value, count))
+}
+
+fn dispatch<T, SA, SB, O, const CAP: usize>(
+    a: &Patch<'_, T, SA>,
+    b: &Patch<'_, T, SB>,
+    settings: PairSettings,
+    occluders: &O,
+) -> Result<(T, u64), PdmError>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
     let p4 = (settings.order as u64).pow(4);
     let (adjacency, gap) = classify_near(a, b);
     match adjacency {
