@@ -65,8 +65,13 @@ use crate::surface::{ParamRect, Surface};
 use crate::vec3::{vec3, Vec3};
 use crate::visibility::Occluder;
 
-/// Largest number of visibility changes located on one inner line.
+/// Largest number of visibility changes located on one inner line or in s at once; a part of
+/// the inner patch with more is halved (see [`MAX_SPLITS`]).
 pub const MAX_BREAKS: usize = 16;
+
+/// Most successive halvings of the inner patch when its visibility changes overflow
+/// [`MAX_BREAKS`] (≤ 2^MAX_SPLITS parts per outer point).
+pub const MAX_SPLITS: u32 = 10;
 
 /// A_a·F_{a→b} with visibility boundaries placed into the inner rule (see the module docs);
 /// `order` points per axis on a and per line and per visible piece on b.
@@ -124,7 +129,12 @@ where
     };
     let use_occluders = occluders.may_block_between(&a.enclosing_ball(), &inner_bounds);
     let closed_form = match affine {
-        Some((o, et, _)) => !use_occluders || occluder_polynomials(occluders, o + et, o, et, &mut |_| {}),
+        Some((o, et, _)) => {
+            // Two facing tests plus the occluders' polynomials must fit one line's buffer.
+            let mut polys = 2usize;
+            !use_occluders
+                || (occluder_polynomials(occluders, o + et, o, et, &mut |_| polys += 1) && polys <= MAX_POLYS)
+        }
         None => false,
     };
     let inner = Inner {
@@ -210,7 +220,7 @@ fn occluder_polynomials<T: Real, O: Occluder<T> + ?Sized>(
 }
 
 /// Most polynomials describing visibility along one line (two facing tests + the occluders').
-const MAX_POLYS: usize = 24;
+const MAX_POLYS: usize = 40;
 
 /// The polynomials a τ² + b τ + c of one line.
 struct Polys<T> {
@@ -308,9 +318,8 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
         !polys.overflow
     }
 
-    /// The visible pieces of the t-line of b at s, seen from p.
-    fn line(&self, p: Vec3<T>, np: Vec3<T>, s: T, line: &mut Line<T>) -> Result<(), PdmError> {
-        let r = self.r;
+    /// The visible pieces of the t-line of b at s over r's t-range, seen from p.
+    fn line(&self, p: Vec3<T>, np: Vec3<T>, r: ParamRect<T>, s: T, line: &mut Line<T>) -> Result<(), PdmError> {
         let vis_at = |t: T| {
             let (q, nq) = self.surface.point_and_normal(t, s);
             self.visible(p, np, q, nq)
@@ -344,14 +353,14 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
     /// The structure of a line: (number of breakpoints, visibility of the first piece, which
     /// polynomials make the breaks); an error counts as its own structure (it is reported
     /// again when the line is integrated).
-    fn line_signature(&self, p: Vec3<T>, np: Vec3<T>, s: T) -> (usize, bool, u64) {
+    fn line_signature(&self, p: Vec3<T>, np: Vec3<T>, r: ParamRect<T>, s: T) -> (usize, bool, u64) {
         let mut fresh = None;
         let mut borrowed = self.signature_line.try_borrow_mut();
         let line: &mut Line<T> = match borrowed.as_deref_mut() {
             Ok(line) => line,
             Err(_) => fresh.insert(Line::new()),
         };
-        match self.line(p, np, s, line) {
+        match self.line(p, np, r, s, line) {
             Ok(()) => (line.n, line.first_visible, line.ids),
             Err(_) => (usize::MAX, false, 0),
         }
@@ -363,15 +372,16 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
     /// exactly and kept where the structure differs on the two sides. Other changes (two
     /// polynomials' roots crossing: a polygonal shadow's corner, two shadows meeting) are
     /// bracketed and bisected between them. Returns the nearest singular points just outside
-    /// [s0, s1] (within a quarter of its width), towards which the end pieces are graded.
+    /// [s0, s1] (within a quarter of its width), towards which the end pieces are graded;
+    /// `None` (with nothing pushed) if the lines' polynomials are not available from p.
     fn closed_form_events(
         &self,
         p: Vec3<T>,
         np: Vec3<T>,
+        r: ParamRect<T>,
         out: &mut [T; MAX_BREAKS + 2],
         n: &mut usize,
-    ) -> Result<Outside<T>, PdmError> {
-        let r = self.r;
+    ) -> Result<Option<Outside<T>>, PdmError> {
         let h = r.s1 - r.s0;
         // The coefficients as quadratics in x ∈ [0, 1] (s = s0 + x·h), from three lines.
         let (mut p0, mut ph, mut p1) = (Polys::new(), Polys::new(), Polys::new());
@@ -381,7 +391,7 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
             && p0.n == ph.n
             && ph.n == p1.n;
         if !ok {
-            return Err(PdmError::InvalidResult);
+            return Ok(None);
         }
         // Candidates with the polynomial they come from; an overflow makes every sub-interval
         // count as possibly crossed (see below).
@@ -468,7 +478,7 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
             if c - last <= delta {
                 continue;
             }
-            if self.line_signature(p, np, c - delta) != self.line_signature(p, np, c + delta) {
+            if self.line_signature(p, np, r, c - delta) != self.line_signature(p, np, r, c + delta) {
                 last = c;
                 if c <= r.s0 + delta {
                     outside.0 = Some(c.min(r.s0 - delta));
@@ -496,16 +506,39 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
                 while probes < self.probes && T::from_usize(probes) < T::from_usize(self.probes) * span {
                     probes += 1;
                 }
-                locate_changes(&|s: T| self.line_signature(p, np, s), from, hi, probes, out, n)?;
+                locate_changes(&|s: T| self.line_signature(p, np, r, s), from, hi, probes, out, n)?;
             }
             lo = next.unwrap_or(r.s1);
         }
-        Ok(outside)
+        Ok(Some(outside))
     }
 
     /// J(p) = ∫_b visible (n̂_p·e)(−n_q·e)/L⁴ dq (without the 1/π).
     fn integral(&self, p: Vec3<T>, np: Vec3<T>) -> Result<T, PdmError> {
-        let r = self.r;
+        self.integral_split(p, np, self.r, 0)
+    }
+
+    /// J(p) over the part r of b; where one part holds more visibility changes than the
+    /// fixed buffers ([`MAX_BREAKS`] per line or in s), it is halved (alternately in s and t,
+    /// at most [`MAX_SPLITS`] times) and the halves are integrated separately.
+    fn integral_split(&self, p: Vec3<T>, np: Vec3<T>, r: ParamRect<T>, depth: u32) -> Result<T, PdmError> {
+        match self.integral_over(p, np, r) {
+            Err(PdmError::CapacityExceeded { .. }) if depth < MAX_SPLITS => {
+                let (lo, hi) = if depth % 2 == 0 {
+                    let m = (r.s0 + r.s1) * T::HALF;
+                    (ParamRect { s1: m, ..r }, ParamRect { s0: m, ..r })
+                } else {
+                    let m = (r.t0 + r.t1) * T::HALF;
+                    (ParamRect { t1: m, ..r }, ParamRect { t0: m, ..r })
+                };
+                Ok(self.integral_split(p, np, lo, depth + 1)? + self.integral_split(p, np, hi, depth + 1)?)
+            }
+            other => other,
+        }
+    }
+
+    /// J(p) over the part r of b (r's t- and s-ranges inside b's).
+    fn integral_over(&self, p: Vec3<T>, np: Vec3<T>, r: ParamRect<T>) -> Result<T, PdmError> {
         // J is smooth in s except where the visible set of the t-line changes its structure:
         // a boundary crossing a t-edge, or a boundary tangent to the t-lines (two breakpoints
         // meeting). Split the s-range there.
@@ -513,10 +546,17 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
         let mut ns = 0usize;
         push(&mut s_breaks, &mut ns, r.s0)?;
         let mut outside = (None, None);
-        if self.affine.is_some() {
-            outside = self.closed_form_events(p, np, &mut s_breaks, &mut ns)?;
+        let in_closed_form = match self.affine {
+            Some(_) => self.closed_form_events(p, np, r, &mut s_breaks, &mut ns)?,
+            None => None,
+        };
+        if let Some(o) = in_closed_form {
+            outside = o;
         } else {
-            for t_edge in [r.t0, r.t1] {
+            // The edges are probed just inside b: an edge may be a pole or a disk's centre,
+            // where the normal vanishes and no facing test is defined.
+            let inset = (r.t1 - r.t0) * end_inset::<T>();
+            for t_edge in [r.t0 + inset, r.t1 - inset] {
                 let vis_edge = |s: T| {
                     let (q, nq) = self.surface.point_and_normal(t_edge, s);
                     self.visible(p, np, q, nq)
@@ -539,7 +579,7 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
             for (xs, ws) in self.rule.points() {
                 let (u, du) = graded((xs + T::ONE) * T::HALF, grade_lo, grade_hi);
                 let s = s_lo + width * u;
-                self.line(p, np, s, &mut line)?;
+                self.line(p, np, r, s, &mut line)?;
                 // Integrate the visible pieces (visibility alternates from the first piece).
                 let mut sum = T::ZERO;
                 let mut visible_piece = line.first_visible;
@@ -868,10 +908,14 @@ fn locate_changes<T: Real, K: PartialEq + Copy>(
     n: &mut usize,
 ) -> Result<(), PdmError> {
     let step = (hi - lo) / T::from_usize(probes - 1);
-    let mut prev_t = lo;
+    // The end probes sit just inside the interval: an end may be a point where the surface's
+    // normal vanishes (a pole, a disk's centre), whose facing tests fail although every point
+    // next to it passes; probing it would report a change that is not there.
+    let inset = (hi - lo) * end_inset::<T>();
+    let mut prev_t = lo + inset;
     let mut prev_v = f(prev_t);
     for k in 1..probes {
-        let t = if k == probes - 1 { hi } else { lo + step * T::from_usize(k) };
+        let t = if k == probes - 1 { hi - inset } else { lo + step * T::from_usize(k) };
         let v = f(t);
         // Several changes between two probes (A → B → C) show as a value after the first
         // change that is not yet the probe's: keep bisecting from there. (A → B → A pairs
@@ -891,6 +935,15 @@ fn locate_changes<T: Real, K: PartialEq + Copy>(
         prev_v = v;
     }
     Ok(())
+}
+
+/// Relative distance from an interval's ends at which visibility is probed instead of the end
+/// itself (ε^¾: 1.8e-12 in f64, 6.4e-6 in f32). A change closer to an end than this is not
+/// placed into the rule; the rule then integrates across it on a piece of that width.
+#[inline]
+fn end_inset<T: Real>() -> T {
+    let e = T::EPSILON.sqrt();
+    e * e.sqrt()
 }
 
 /// Insertion sort of (position, tag) pairs by position (few elements, no allocation, no

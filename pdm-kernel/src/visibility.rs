@@ -250,8 +250,19 @@ impl<T: Real> Occluder<T> for Sphere<T> {
         let m = self.center - p;
         let w0 = origin - p;
         let d = direction;
-        let (a, b, c) = cone_polynomial(m, m.norm2() - self.radius * self.radius, w0, d);
-        out([a, b, c]);
+        let r2 = self.radius * self.radius;
+        let k = m.norm2() - r2;
+        if on_surface(k, r2) {
+            // p on the sphere (a patch of the occluder itself): the tangent cone degenerates
+            // to p's tangent plane, and its polynomial to rounding noise with a double root.
+            // A segment into the sphere (m·w > 0) meets it again at τ = 2 m·w/|w|², i.e. is
+            // blocked iff q lies outside: |w|² − 2 m·w > 0.
+            let (e0, e1) = (w0 - m.scale(T::TWO), d);
+            out([d.dot(e1), w0.dot(e1) + d.dot(e0), w0.dot(e0)]);
+        } else {
+            let (a, b, c) = cone_polynomial(m, k, w0, d);
+            out([a, b, c]);
+        }
         out([T::ZERO, m.dot(d), m.dot(w0)]);
         let (a, b, c) = sphere_polynomial(origin, d, self.center, self.radius);
         out([a, b, c]);
