@@ -37,6 +37,11 @@ pub enum PdmError {
     /// rule that cannot resolve the pair (too close, too thin) gives such values; they are
     /// refused instead of returned.
     InvalidResult,
+    /// The working precision cannot resolve this pair: its result would keep fewer than half
+    /// the precision's digits (terms cancelling by many orders of magnitude, as for strips of
+    /// extreme aspect ratio), so it is refused instead of returned inexact. Use `f64`, or
+    /// split the surfaces.
+    Unresolvable,
     /// A setting outside its valid range (a tolerance that is not positive and finite, a
     /// maximum order the kernel cannot use, …).
     InvalidSetting {
@@ -62,6 +67,9 @@ impl fmt::Display for PdmError {
             }
             Self::InvalidResult => f.write_str(
                 "form factor outside the physical bounds (not finite, F < 0, F > 1 or A_a*F_ab > min(A_a, A_b))",
+            ),
+            Self::Unresolvable => f.write_str(
+                "the working precision cannot resolve this pair (its terms cancel by more than half the digits)",
             ),
             Self::InvalidSetting { name, expected } => write!(f, "invalid setting {name}: must be {expected}"),
         }

@@ -41,6 +41,8 @@
 pub mod adaptive;
 pub mod boundary;
 mod bounds;
+#[cfg(feature = "closed-form")]
+mod contour;
 pub mod dual;
 pub mod error;
 pub mod fixed;

@@ -19,6 +19,8 @@ use crate::real::Real;
 use crate::samples::PatchSamples;
 use crate::singular::{classify_near, touching_exchange, Adjacency};
 use crate::surface::Surface;
+#[cfg(feature = "closed-form")]
+use crate::vec3::Vec3;
 use crate::visibility::Occluder;
 
 /// Cells per side into which the outer patch of a pair that an occluder may cut is split.
@@ -80,10 +82,90 @@ where
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
-    let (value, count) = dispatch::<T, SA, SB, O, CAP>(a, b, settings, occluders)?;
+    let (mut value, mut count) = (T::ZERO, 0u64);
+    for_each_piece_pair(a, b, |pa, pb| {
+        let (v, c) = dispatch::<T, SA, SB, O, CAP>(pa, pb, settings, occluders)?;
+        value += v;
+        count = count.saturating_add(c);
+        Ok(())
+    })?;
     let order = settings.order.max(2);
     let value = crate::bounds::exchange(value, a.area(order)?, b.area(order)?)?;
     Ok((value, count))
+}
+
+/// `true` if two patches are closer than the larger one's radius: the plain rule's error then
+/// falls slowly with the order (the kernel's nearest singularity is within a patch size), and the
+/// boundary path, which refines the inner patch towards each outer point, takes the pair.
+fn near<T: Real>(a: &crate::samples::Ball<T>, b: &crate::samples::Ball<T>) -> bool {
+    (a.center - b.center).norm() - a.radius - b.radius < a.radius.max(b.radius)
+}
+
+/// Calls `f` on every pair of pieces of a and b (see [`pieces`]): the pair methods then see
+/// only patches whose four corners are distinct unless an edge collapses to a point.
+pub(crate) fn for_each_piece_pair<'s, 'r, T, SA, SB>(
+    a: &Patch<'s, T, SA>,
+    b: &Patch<'r, T, SB>,
+    mut f: impl FnMut(&Patch<'s, T, SA>, &Patch<'r, T, SB>) -> Result<(), PdmError>,
+) -> Result<(), PdmError>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+{
+    let (ma, na) = pieces(a);
+    let (mb, nb) = pieces(b);
+    if ma * na * mb * nb == 1 {
+        return f(a, b);
+    }
+    let (ra, rb) = (a.rect(), b.rect());
+    for i in 0..ma * na {
+        let pa = Patch::new(a.surface(), ra.cell(i / na, i % na, ma, na))?;
+        for j in 0..mb * nb {
+            let pb = Patch::new(b.surface(), rb.cell(j / nb, j % nb, mb, nb))?;
+            f(&pa, &pb)?;
+        }
+    }
+    Ok(())
+}
+
+/// Into how many pieces (along t, along s) a patch is cut before integration: a direction in
+/// which the patch's image closes on itself, or nearly (the chord between its ends less than
+/// half the arc through its middle: the seam of a whole disk, cylinder, cone or sphere at
+/// θ = 0 = 2π), is cut into 4 pieces, one that bends by more than about a half turn (chord
+/// below ¾ of the arc: a sphere from pole to pole) into 2. The touching-pair classification
+/// compares corners and edges, which a closed patch does not have apart; the transforms and
+/// the splitter assume pieces that bend by much less than a full turn.
+pub(crate) fn pieces<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>) -> (usize, usize) {
+    let r = p.rect();
+    let g = p.surface();
+    let (tm, sm) = ((r.t0 + r.t1) * T::HALF, (r.s0 + r.s1) * T::HALF);
+    let count = |chord: T, arc: T| -> usize {
+        if !(arc > T::ZERO) || !chord.is_finite() || !arc.is_finite() {
+            1
+        } else if chord < arc * T::HALF {
+            4
+        } else if chord < arc * T::from_f64(0.75) {
+            2
+        } else {
+            1
+        }
+    };
+    let along_t = |t0: T, t1: T| (g.point(t1, sm) - g.point(t0, sm)).norm();
+    let along_s = |s0: T, s1: T| (g.point(tm, s1) - g.point(tm, s0)).norm();
+    let arc = |seg: &dyn Fn(T, T) -> T, lo: T, hi: T| -> T {
+        const SEGMENTS: usize = 16;
+        let mut length = T::ZERO;
+        for k in 0..SEGMENTS {
+            let x0 = lo + (hi - lo) * T::from_usize(k) / T::from_usize(SEGMENTS);
+            let x1 = lo + (hi - lo) * T::from_usize(k + 1) / T::from_usize(SEGMENTS);
+            length += seg(x0, x1);
+        }
+        length
+    };
+    let m = count(along_t(r.t0, r.t1), arc(&along_t, r.t0, r.t1));
+    let n = count(along_s(r.s0, r.s1), arc(&along_s, r.s0, r.s1));
+    (m, n)
 }
 
 fn dispatch<T, SA, SB, O, const CAP: usize>(
@@ -100,6 +182,13 @@ where
 {
     let p4 = (settings.order as u64).pow(4);
     let (adjacency, gap) = classify_near(a, b);
+    #[cfg(feature = "closed-form")]
+    if settings.boundaries && (adjacency == Adjacency::Separate || (adjacency != Adjacency::Identical && gap > T::ZERO))
+    {
+        if let Some(result) = flat_pair(a, b, settings.order, occluders) {
+            return result;
+        }
+    }
     match adjacency {
         Adjacency::SharedEdge { .. } | Adjacency::SharedVertex { .. } => {
             let q4 = (settings.singular_order as u64).pow(4);
@@ -135,7 +224,7 @@ where
                     count = count.saturating_add(c);
                 }
                 Ok((total, count))
-            } else if straddles_curvature_cut(&sa, &sb) {
+            } else if straddles_curvature_cut(&sa, &sb) || near(&a.enclosing_ball(), &b.enclosing_ball()) {
                 let (v, c) = boundary_exchange_counted::<T, SA, SB, (), CAP>(a, b, settings.order, &())?;
                 Ok((v, c.saturating_add(p4)))
             } else {
@@ -144,4 +233,63 @@ where
             }
         }
     }
+}
+
+/// Two flat patches (parallelograms) that see each other wholly — each in the closed half-space
+/// in front of the other, not coplanar, no occluder able to cut a segment between them — by the
+/// contour form ([`crate::contour`]), exact at any gap and aspect ratio; `None` if the pair is
+/// not such a pair.
+#[cfg(feature = "closed-form")]
+fn flat_pair<T, SA, SB, O>(
+    a: &Patch<'_, T, SA>,
+    b: &Patch<'_, T, SB>,
+    order: usize,
+    occluders: &O,
+) -> Option<Result<(T, u64), PdmError>>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
+    let (ca, na) = flat_corners(a)?;
+    let (cb, nb) = flat_corners(b)?;
+    // Each wholly in front of (or on) the other's plane, and not both in one plane.
+    let size = ca.iter().chain(cb.iter()).fold(T::ZERO, |m, &p| m.max((p - ca[0]).norm()));
+    let band = size * T::GEOMETRY_TOLERANCE;
+    let side = |corners: &[Vec3<T>; 4], origin: Vec3<T>, n: Vec3<T>| {
+        let mut ahead = false;
+        for &q in corners {
+            let h = n.dot(q - origin);
+            if h < -band {
+                return None;
+            }
+            ahead |= h > band;
+        }
+        Some(ahead)
+    };
+    if !(side(&cb, ca[0], na)? && side(&ca, cb[0], nb)?) {
+        return None;
+    }
+    if occluders.may_block_between(&a.enclosing_ball(), &b.enclosing_ball()) {
+        return None;
+    }
+    Some(crate::contour::quad_exchange(&ca, &cb, order.max(4)))
+}
+
+/// A flat patch's corners counter-clockwise about its radiating normal, and its unit normal.
+#[cfg(feature = "closed-form")]
+fn flat_corners<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>) -> Option<([Vec3<T>; 4], Vec3<T>)> {
+    let (o, et, es) = p.surface().affine_map()?;
+    let r = p.rect();
+    let at = |t: T, s: T| o + et.scale(t) + es.scale(s);
+    let corners = [at(r.t0, r.s0), at(r.t1, r.s0), at(r.t1, r.s1), at(r.t0, r.s1)];
+    let normal = p.surface().normal((r.t0 + r.t1) * T::HALF, (r.s0 + r.s1) * T::HALF);
+    let length = normal.norm();
+    if !(length > T::ZERO) || !length.is_finite() {
+        return None;
+    }
+    let n = normal.scale(T::ONE / length);
+    let [c0, c1, c2, c3] = corners;
+    Some(if n.dot(et.cross(es)) >= T::ZERO { (corners, n) } else { ([c0, c3, c2, c1], n) })
 }
