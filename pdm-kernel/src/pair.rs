@@ -1,14 +1,24 @@
 //! One entry point for any pair of patches: picks the integration method the pair needs.
 //!
+//! - A patch whose image closes on itself (a whole disk, cylinder, cone or sphere as one
+//!   patch) is first cut at its seam into pieces ([`pieces`]); every pair of pieces is then
+//!   dispatched as below and the results are summed.
 //! - Touching pairs (shared edge or vertex, found by [`crate::singular::classify_near`], also
 //!   when they are only nearly touching) use the regularising
 //!   transforms of [`crate::singular`], converging exponentially with `singular_order`.
 //! - The same patch twice uses the interlaced-order self integral ([`crate::self_form_factor`]).
-//! - Separate pairs use the PDM sum at `order`. With `boundaries` on, a pair that straddles a
-//!   back-face cut or that an occluder may cut gets the visibility boundaries placed into the
-//!   inner rule ([`crate::boundary`]; the outer patch is also split
-//!   [`OCCLUDED_OUTER_SPLIT`]² when an occluder may cut); smooth, unoccludable pairs keep the
-//!   plain sum.
+//! - Two flat patches (parallelograms) that see each other wholly, with no occluder able to cut
+//!   between them and not in exact contact, use the contour form ([`crate::contour`]): exact at
+//!   any gap, from far apart down to nearly coincident.
+//! - Other separate pairs use the PDM sum at `order`. With `boundaries` on, a pair that
+//!   straddles a back-face cut, that an occluder may cut, or whose patches are closer than
+//!   their size gets the visibility boundaries placed into the inner rule and the inner patch
+//!   refined towards each outer point ([`crate::boundary`]; the outer patch is also split
+//!   [`OCCLUDED_OUTER_SPLIT`]² when an occluder may cut); smooth, distant, unoccludable pairs
+//!   keep the plain sum.
+//!
+//! Every value is checked against the physical bounds 0 ≤ A_a·F_{a→b} ≤ min(A_a, A_b) before
+//! it is returned.
 
 use crate::adaptive::straddles_curvature_cut;
 use crate::boundary::boundary_exchange_counted;
@@ -49,8 +59,33 @@ impl PairSettings {
     pub const ACCURATE: Self = Self { order: 16, singular_order: 12, boundaries: true };
 }
 
-/// A_a·F_{a→b} for any two patches (symmetric in a and b), by the method the pair needs.
-/// `CAP` bounds the samples of one patch (≥ order²).
+/// A_a·F_{a→b} for any two patches, by the method the pair needs (see the module docs).
+///
+/// The quantity is symmetric (A_a·F_{a→b} = A_b·F_{b→a}); the computation is not quite: on
+/// the boundary path a is integrated outside (its Gauss points) and b inside (its visible part
+/// from each point of a), so the two argument orders agree to the quadrature error, not to the
+/// last digit. Divide by A_a ([`Patch::area`]) for F_{a→b}.
+///
+/// Orientation: each patch radiates to the side its normal ∂g/∂t × ∂g/∂s points to (a
+/// surface's `Side`, or [`crate::Flipped`]). `Ok(0.0)` means no segment between the two
+/// patches passes the facing tests and the occluders: the patches are back to back, face
+/// away from each other, are hidden, or one faces away from the other — a mistaken
+/// orientation gives the same zero as a true one, so check the sides when a zero surprises.
+///
+/// `CAP` bounds the samples of one patch: ≥ order² (and ≥ (order + 1)² if a and b may be the
+/// same patch). Errors: bad input, `Err(InvalidResult)` for a value outside the physical
+/// bounds, `Err(Unresolvable)` where the working precision cannot resolve the pair.
+///
+/// ```
+/// use pdm_kernel::{pair_exchange, vec3, PairSettings, Parallelogram, Patch};
+/// // Two perpendicular unit squares sharing an edge (catalogue C-14: F = 0.2000437760754...).
+/// let floor = Parallelogram::new(vec3(0.0, 0.0, 0.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0))?;
+/// let wall = Parallelogram::new(vec3(0.0, 0.0, 0.0), vec3(0.0, 0.0, 1.0), vec3(1.0, 0.0, 0.0))?;
+/// let f = pair_exchange::<f64, _, _, _, 256>(
+///     &Patch::whole(&floor)?, &Patch::whole(&wall)?, PairSettings::ACCURATE, &())?;
+/// assert!((f - 0.20004377607540316).abs() < 1e-12);
+/// # Ok::<(), pdm_kernel::PdmError>(())
+/// ```
 pub fn pair_exchange<T, SA, SB, O, const CAP: usize>(
     a: &Patch<'_, T, SA>,
     b: &Patch<'_, T, SB>,
@@ -212,20 +247,21 @@ where
             let may_occlude = occluders.may_block_between(&sa.bounds(), &sb.bounds())
                 || occluders.may_block_between(&a.enclosing_ball(), &b.enclosing_ball());
             if may_occlude {
-                // Shadow edges crossing b make the outer integrand kink where they touch b's
-                // edges; the outer patch is split (see OCCLUDED_OUTER_SPLIT).
-                let (mut total, mut count) = (T::ZERO, 0u64);
-                let r = a.rect();
-                let n = OCCLUDED_OUTER_SPLIT;
-                for k in 0..n * n {
-                    let child = Patch::new(a.surface(), r.cell(k / n, k % n, n, n))?;
-                    let (v, c) = boundary_exchange_counted::<T, SA, SB, O, CAP>(&child, b, settings.order, occluders)?;
-                    total += v;
-                    count = count.saturating_add(c);
+                // The inner rule is in closed form only on a flat (affine) inner patch: put it
+                // inside when only one of the two is flat.
+                if has_affine_map(b) || !has_affine_map(a) {
+                    occluded::<T, SA, SB, O, CAP>(a, b, settings.order, occluders)
+                } else {
+                    occluded::<T, SB, SA, O, CAP>(b, a, settings.order, occluders)
                 }
-                Ok((total, count))
             } else if straddles_curvature_cut(&sa, &sb) || near(&a.enclosing_ball(), &b.enclosing_ball()) {
-                let (v, c) = boundary_exchange_counted::<T, SA, SB, (), CAP>(a, b, settings.order, &())?;
+                // A curved outer patch sweeps its tangent plane across the inner one, which
+                // adds kinks to the outer integrand; a flat one does not: put it outside.
+                let (v, c) = if is_flat(b) && !is_flat(a) {
+                    boundary_exchange_counted::<T, SB, SA, (), CAP>(b, a, settings.order, &())?
+                } else {
+                    boundary_exchange_counted::<T, SA, SB, (), CAP>(a, b, settings.order, &())?
+                };
                 Ok((v, c.saturating_add(p4)))
             } else {
                 // Smooth pair: nothing to place into the rule, no occluder can cut it.
@@ -233,6 +269,66 @@ where
             }
         }
     }
+}
+
+/// The boundary path with the outer patch split [`OCCLUDED_OUTER_SPLIT`]²: shadow edges
+/// crossing b make the outer integrand kink where they touch b's edges.
+fn occluded<T, SA, SB, O, const CAP: usize>(
+    a: &Patch<'_, T, SA>,
+    b: &Patch<'_, T, SB>,
+    order: usize,
+    occluders: &O,
+) -> Result<(T, u64), PdmError>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
+    let (mut total, mut count) = (T::ZERO, 0u64);
+    let r = a.rect();
+    let n = OCCLUDED_OUTER_SPLIT;
+    for k in 0..n * n {
+        let child = Patch::new(a.surface(), r.cell(k / n, k % n, n, n))?;
+        let (v, c) = boundary_exchange_counted::<T, SA, SB, O, CAP>(&child, b, order, occluders)?;
+        total += v;
+        count = count.saturating_add(c);
+    }
+    Ok((total, count))
+}
+
+/// Whether the patch's surface is a parallelogram (an affine map), which the boundary path
+/// integrates in closed form as the inner patch.
+fn has_affine_map<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>) -> bool {
+    #[cfg(feature = "closed-form")]
+    return p.surface().affine_map().is_some();
+    #[cfg(not(feature = "closed-form"))]
+    {
+        let _ = p;
+        false
+    }
+}
+
+/// Whether the patch is flat: its unit normals at the centre and near the four corners agree to
+/// rounding (a parallelogram, a disk or annulus sector, a planar Bézier patch).
+fn is_flat<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>) -> bool {
+    let r = p.rect();
+    let g = p.surface();
+    let at = |x: T, y: T| {
+        let n = g.normal(r.t0 + (r.t1 - r.t0) * x, r.s0 + (r.s1 - r.s0) * y);
+        let length = n.norm();
+        if length > T::ZERO && length.is_finite() {
+            Some(n.scale(T::ONE / length))
+        } else {
+            None
+        }
+    };
+    let (lo, hi) = (T::from_f64(0.125), T::from_f64(0.875));
+    let Some(centre) = at(T::HALF, T::HALF) else { return false };
+    let limit = T::ONE - T::from_f64(64.0) * T::EPSILON;
+    [(lo, lo), (hi, lo), (lo, hi), (hi, hi)]
+        .iter()
+        .all(|&(x, y)| at(x, y).is_some_and(|n| n.dot(centre) >= limit))
 }
 
 /// Two flat patches (parallelograms) that see each other wholly — each in the closed half-space

@@ -174,10 +174,14 @@ fn poles_are_handled_not_divided_by() {
     for order in 1..=MAX_ORDER {
         let a = PatchSamples::<f64, 1024>::new(&cap, order).unwrap();
         let b = PatchSamples::<f64, 1024>::new(&fp, order).unwrap();
-        let f = form_factor(&a, &b, &s).unwrap();
-        // (At order 1–2 a single sample pair may overestimate a large close face beyond 1: the
-        // plain rule is not a bound; we only require a finite positive value here.)
-        assert!(f.is_finite() && f > 0.0, "order {order}: {f}");
+        // At order 1–2 a single sample pair overestimates the large close face beyond 1: the
+        // kernel refuses that value instead of returning it.
+        let f = match form_factor(&a, &b, &s) {
+            Ok(f) => f,
+            Err(PdmError::InvalidResult) if order <= 2 => continue,
+            Err(e) => panic!("order {order}: {e}"),
+        };
+        assert!(f.is_finite() && f > 0.0 && f <= 1.0, "order {order}: {f}");
         if order >= 16 {
             // Convergence only (the cap straddles no singularity but the rule is not exact).
             assert!((f - converged).abs() < 2e-3 * converged, "order {order}: {f} vs {converged}");

@@ -203,3 +203,24 @@ fn nearly_coincident_plates_and_long_strips() {
         }
     }
 }
+
+/// A whole disk closing a whole cylinder wall across a gap (the disk just below the wall's
+/// rim): F_disk→wall is 1 − F_disk→(the wall's far rim disk) − F_disk→(the ring of the gap),
+/// i.e. by the C-41 algebra F = F(disk → disk at gap) − F(disk → disk at gap + H), both coaxial
+/// disks of the same radius.
+#[test]
+fn whole_disk_closing_a_wall_across_a_gap() {
+    let (radius, height) = (1.0, 1.3);
+    let s = PairSettings { order: 16, singular_order: 14, boundaries: true };
+    for gap in [1e-3, 1e-6] {
+        let disk = Disk::new(v([0.0, 0.0, -gap]), v([0.0, 0.0, 1.0]), radius).unwrap();
+        let wall = Cylinder::new(v([0.0, 0.0, 0.0]), v([0.0, 0.0, 1.0]), radius, height, Side::Inner).unwrap();
+        let exact = exact::coaxial_disks(radius, radius, gap) - exact::coaxial_disks(radius, radius, gap + height);
+        let area = core::f64::consts::PI * radius * radius;
+        let (d, w) = (Patch::whole(&disk).unwrap(), Patch::whole(&wall).unwrap());
+        let dw = pair_exchange::<f64, _, _, _, 1024>(&d, &w, s, &()).unwrap() / area;
+        let wd = pair_exchange::<f64, _, _, _, 1024>(&w, &d, s, &()).unwrap() / area;
+        println!("gap {gap:e}: {dw} / {wd} vs {exact}: {:.1e} / {:.1e}", rel(dw, exact), rel(wd, exact));
+        assert!(rel(dw, exact) < 1e-6 && rel(wd, exact) < 1e-6, "gap {gap}");
+    }
+}
