@@ -20,7 +20,7 @@
 //! Modes: CI (default; Monte Carlo 4e5 rays per case) and long (`PDM_BATTERY=long`: 4e6 rays,
 //! more gaps, aspects and grids). Print the per-class summary with `--nocapture`.
 //! CI-mode runtime, measured 2026-12-01 in release on this 2-core machine (shared with other
-//! builds): 40.3 s for the 10 default tests (`cargo test --release -p pdm-host --test battery`;
+//! builds): 40–46 s for the 10 default tests (`cargo test --release -p pdm-host --test battery`;
 //! the slowest classes are mc-occluded 33 s and closed-curved 24 s, kernel time, not rays).
 //! Building the test binary comes on top (1.5–7 min here, depending on the load).
 
@@ -1253,6 +1253,7 @@ fn mark_known(v: Vec<Case>) -> Vec<Case> {
         ("disk sector -> polar sphere cell (reversed)", "issue 11 item 1: pair_exchange F = 1.3e-39 (f32 3.7e-22), MC 0.08679 ± 4.5e-4 (plain 0.08637)"),
         ("sphere cell -> tilted plate crossing its horizon", "issue 11 item 1: pair_exchange not symmetric on a back-face-cut pair: A·F 0.40048607 vs 0.40048509 (2.4e-6)"),
         ("cylinder outer patch -> floor it stands on", "issue 11 item 1: pair_exchange F = 0.306866, MC 0.311273 ± 7.3e-4 (-1.4e-2); (b,a) gives 0.326438 (6 % asymmetric)"),
+        ("sphere 1e-8 above a plate 4x4, self-occluding", "issue 11 item 6: pair_exchange (a,b) Err(CapacityExceeded { needed: 19, capacity: 18 }) after 56 s; (b,a) A·F 3.637067, exact Omega = 3.709 (-1.9 %)"),
         ("whole outer cylinder -> floor below (periodic)", "issue 11 item 3: pair_exchange not symmetric on a whole periodic cylinder: A·F 0.982109 vs 1.025536 (4.4 %)"),
     ];
     // Cases that did not finish within 30 s (both precisions, all entry points) with the kernel
@@ -1261,7 +1262,6 @@ fn mark_known(v: Vec<Case>) -> Vec<Case> {
         "whole disk -> wall it closes across gap 1e-6",
         "sphere 4x8 -> disk 2x4 below",
         "paper: sphere 4x8 -> cube floor 2x2 (self-occluding)",
-        "sphere 1e-8 above a plate 4x4, self-occluding",
         "inner sphere 2x4 -> itself",
         "squares, sphere + cylinder + disk between",
         "sphere -> disk below, disk occluder between",
@@ -1393,11 +1393,46 @@ single_case! {
     slow_disk_to_wall_gap_1e_6: "slow: > 30 s with the current kernel (issue 11 item 5)" => "whole disk -> wall it closes across gap 1e-6";
     slow_sphere_grid_to_disk_grid: "slow: > 30 s with the current kernel (issue 11 item 1)" => "sphere 4x8 -> disk 2x4 below";
     slow_paper_sphere_to_floor: "slow: > 30 s with the current kernel" => "paper: sphere 4x8 -> cube floor 2x2 (self-occluding)";
-    slow_sphere_1e_8_above_plate: "slow: > 30 s with the current kernel (issue 11 item 6)" => "sphere 1e-8 above a plate 4x4, self-occluding";
+    known_failing_sphere_1e_8_above_plate: "issue 11 item 6: Err(CapacityExceeded) one way, -1.9 % the other, 56 s" => "sphere 1e-8 above a plate 4x4, self-occluding";
     slow_inner_sphere_grid_to_itself: "slow: > 30 s with the current kernel (pair_exchange f64 right, 17 s)" => "inner sphere 2x4 -> itself";
     slow_squares_three_occluders: "slow: > 30 s with the current kernel (pair_exchange 14 s per direction)" => "squares, sphere + cylinder + disk between";
     slow_sphere_to_disk_disk_occluder: "slow: > 30 s with the current kernel" => "sphere -> disk below, disk occluder between";
     slow_disk_to_sphere_cylinder_occluder: "slow: > 30 s with the current kernel" => "disk -> sphere, cylinder occluder between";
     slow_cone_to_base_sphere_inside: "slow: > 30 s with the current kernel" => "cone inside -> its base disk, sphere inside";
     slow_concentric_cylinders: "slow: > 30 s with the current kernel (issue 11 item 4)" => "outer wall half -> other half, inner tube occluding";
+}
+
+/// The plain rule (`surface_form_factor`, order 16) on every CI case: issue 11 item 4 asks that
+/// it be right (here: within 1e-3, or 4σ + 1e-3 against Monte Carlo) or refuse where it is
+/// known to be wrong (touching, nearly touching, identical patches).
+#[test]
+#[ignore = "issue 11 item 4: the plain rule returns wrong values as Ok on touching and identical pairs"]
+fn known_failing_plain_rule_on_touching_pairs() {
+    let cases: Vec<Case> = all_cases().into_iter().filter(|c| !c.slow).collect();
+    let mut failures = Vec::new();
+    for (i, c) in cases.iter().enumerate() {
+        let r = reference(c, 1000 + i as u64);
+        let built = kernel_surface::<f64>(&c.a.kind).and_then(|a| Ok((a, kernel_surface::<f64>(&c.b.kind)?)));
+        let occ: Result<Vec<AnyOccluder<f64>>, _> = c.occ.iter().map(Occ::kernel).collect();
+        let (Ok((sa, sb)), Ok(occ)) = (built, occ) else { panic!("{}: geometry", c.name) };
+        let plain = match (grid_of::<f64>(&c.a, &*sa), grid_of::<f64>(&c.b, &*sb)) {
+            (Ok(ga), Ok(gb)) => surface_form_factor::<f64, _, _, _, CAP>(ga, gb, Quadrature::uniform(16), &occ[..]),
+            (Err(e), _) | (_, Err(e)) => Err(e),
+        };
+        if let Ok(f) = plain {
+            let allowed = if r.mc { 4.0 * r.unc + 1e-3 * r.f } else { 1e-3 * r.f };
+            let line = format!(
+                "{:<48} plain {f:.9e} reference {:.9e} ({}) rel {:+.2e}",
+                c.name,
+                r.f,
+                r.source,
+                (f - r.f) / r.f
+            );
+            println!("{line}");
+            if (f - r.f).abs() > allowed {
+                failures.push(line);
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{} wrong plain values returned as Ok:\n{}", failures.len(), failures.join("\n"));
 }
