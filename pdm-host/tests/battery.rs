@@ -17,6 +17,11 @@
 //! issue item they reproduce: `cargo test --release -p pdm-host --test battery -- --ignored
 //! --nocapture` shows their numbers. Everything else runs by default.
 //!
+//! Too slow cases (> 30 s each with the current kernel, not yet known to fail) are in `slow_*`
+//! tests, also `#[ignore]`d, and run in long mode. Exploration: `PDM_BATTERY_LIST=1` lists the
+//! cases, `PDM_BATTERY_CASE=i PDM_BATTERY_TRACE=1 … battery_everything --ignored` runs one with
+//! progress output (use an external `timeout`).
+//!
 //! Modes: CI (default; Monte Carlo 4e5 rays per case) and long (`PDM_BATTERY=long`: 4e6 rays,
 //! more gaps, aspects and grids). Print the per-class summary with `--nocapture`.
 //! CI-mode runtime, measured 2026-12-01 in release on this 2-core machine (shared with other
@@ -1254,12 +1259,12 @@ fn mark_known(v: Vec<Case>) -> Vec<Case> {
         ("sphere cell -> tilted plate crossing its horizon", "issue 11 item 1: pair_exchange not symmetric on a back-face-cut pair: A·F 0.40048607 vs 0.40048509 (2.4e-6)"),
         ("cylinder outer patch -> floor it stands on", "issue 11 item 1: pair_exchange F = 0.306866, MC 0.311273 ± 7.3e-4 (-1.4e-2); (b,a) gives 0.326438 (6 % asymmetric)"),
         ("sphere 1e-8 above a plate 4x4, self-occluding", "issue 11 item 6: pair_exchange (a,b) Err(CapacityExceeded { needed: 19, capacity: 18 }) after 56 s; (b,a) A·F 3.637067, exact Omega = 3.709 (-1.9 %)"),
+        ("whole disk -> wall it closes across gap 1e-6", "issue 11 item 5: f64 refused (InvalidResult), f32 pair_exchange takes 259 s and gives F = 0.617199, C-41(g) - C-41(1+g) = 0.618033 (-1.3e-3)"),
         ("whole outer cylinder -> floor below (periodic)", "issue 11 item 3: pair_exchange not symmetric on a whole periodic cylinder: A·F 0.982109 vs 1.025536 (4.4 %)"),
     ];
     // Cases that did not finish within 30 s (both precisions, all entry points) with the kernel
     // at this commit: run only by their own ignored tests and in long mode.
     let slow: &[&str] = &[
-        "whole disk -> wall it closes across gap 1e-6",
         "sphere 4x8 -> disk 2x4 below",
         "paper: sphere 4x8 -> cube floor 2x2 (self-occluding)",
         "inner sphere 2x4 -> itself",
@@ -1390,7 +1395,7 @@ single_case! {
     known_failing_sphere_cell_to_tilted_plate: "issue 11 item 1: not symmetric across the back-face cut (2.4e-6)" => "sphere cell -> tilted plate crossing its horizon";
     known_failing_cylinder_patch_to_floor: "issue 11 item 1: cylinder patch -> floor 1.4e-2 low, 6 % asymmetric" => "cylinder outer patch -> floor it stands on";
     known_failing_whole_cylinder_to_floor: "issue 11 item 3: whole periodic cylinder -> floor 4.4 % asymmetric" => "whole outer cylinder -> floor below (periodic)";
-    slow_disk_to_wall_gap_1e_6: "slow: > 30 s with the current kernel (issue 11 item 5)" => "whole disk -> wall it closes across gap 1e-6";
+    known_failing_disk_to_wall_gap_1e_6: "issue 11 item 5: f32 -1.3e-3 after 259 s (f64 refused)" => "whole disk -> wall it closes across gap 1e-6";
     slow_sphere_grid_to_disk_grid: "slow: > 30 s with the current kernel (issue 11 item 1)" => "sphere 4x8 -> disk 2x4 below";
     slow_paper_sphere_to_floor: "slow: > 30 s with the current kernel" => "paper: sphere 4x8 -> cube floor 2x2 (self-occluding)";
     known_failing_sphere_1e_8_above_plate: "issue 11 item 6: Err(CapacityExceeded) one way, -1.9 % the other, 56 s" => "sphere 1e-8 above a plate 4x4, self-occluding";
