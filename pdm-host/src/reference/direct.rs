@@ -150,6 +150,12 @@ fn exchange(a: &[(V3, V3)], b: &[(V3, V3)]) -> f64 {
         / PI
 }
 
+/// Area of a patch, ∫|∂g/∂t × ∂g/∂s|, by a 32-point rule on 4 × 4 cells (≈ 1e-15 relative on
+/// smooth patches).
+pub fn patch_area<S: ParamSurface + ?Sized>(s: &S) -> f64 {
+    samples(s, 4, &GaussLegendre::new(32)).iter().map(|&(_, n)| norm(n)).sum()
+}
+
 /// F_{a→b} to relative tolerance `rel_tol` (see the module docs for validity). `None` if the
 /// tolerance is not reached with 8 × 8 cells at order 32 or the area is not positive.
 pub fn direct_form_factor<A, B>(a: &A, b: &B, rel_tol: f64) -> Option<DirectEstimate>
