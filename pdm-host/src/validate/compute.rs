@@ -33,6 +33,10 @@ pub struct Values {
     /// factors, each the sum of its patch pairs' estimates relative to the factor
     /// (`adaptive_exchange`'s `Estimate::error`); `None` in the fixed modes.
     pub estimated_error: Option<f64>,
+    /// Tolerance mode only: the number of patch pairs whose estimate did not meet the
+    /// tolerance (`Estimate::converged` false: subdivision limit or precision floor);
+    /// `None` in the fixed modes.
+    pub unconverged_pairs: Option<u64>,
 }
 
 /// Wall times of one computation, seconds.
@@ -47,8 +51,9 @@ pub struct Times {
 type Face<T> = Parallelogram<T>;
 
 /// Face → face part: exchange sums of the 15 face pairs, the 6 face areas, and the sums of the
-/// kernel's error estimates of the 15 pairs (tolerance mode; zero otherwise).
-type FaceFaceSums<T> = ([T; 15], [T; 6], [T; 15]);
+/// kernel's error estimates of the 15 pairs and the number of patch pairs that did not converge
+/// (tolerance mode; zero otherwise).
+type FaceFaceSums<T> = ([T; 15], [T; 6], [T; 15], u64);
 
 fn kernel(context: &'static str) -> impl Fn(PdmError) -> ValidateError {
     move |error| ValidateError::Kernel { context, error }
@@ -94,10 +99,10 @@ pub fn run_once<T: Real, const CAP: usize>(
     // Part 2: face → face (Table 3), eq. (26), the sphere as occluder.
     progress.stage("face -> face");
     let start = Instant::now();
-    let (face_exchange, face_area, face_error) = match cfg.mode {
+    let (face_exchange, face_area, face_error, face_unconverged) = match cfg.mode {
         Mode::Paper => {
             let (exchange, area) = paper_face_face::<T, CAP>(cfg, &scene.sphere, &face_patches, progress)?;
-            (exchange, area, [T::ZERO; 15])
+            (exchange, area, [T::ZERO; 15], 0)
         }
         Mode::Accurate => accurate_face_face::<T, CAP>(cfg, &scene.sphere, &face_patches, progress)?,
     };
@@ -110,8 +115,10 @@ pub fn run_once<T: Real, const CAP: usize>(
         let sphere = part1.iter().flat_map(|p| p.error.iter().zip(&p.exchange).map(|(&e, &x)| relative(e, x)));
         faces.chain(sphere).fold(0.0, f64::max)
     });
+    let unconverged_pairs = cfg.tolerance.map(|_| face_unconverged + part1.as_ref().map_or(0, |p| p.unconverged));
     let mut values = derive(part1, &face_exchange, &face_area)?;
     values.estimated_error = estimated_error;
+    values.unconverged_pairs = unconverged_pairs;
     Ok((values, Times { sphere_face: sphere_face_seconds, face_face: face_face_seconds }))
 }
 
@@ -120,6 +127,8 @@ struct SpherePart<T> {
     exchange: [T; 6],
     /// Σ of the kernel's error estimates per face (tolerance mode; zero otherwise).
     error: [T; 6],
+    /// Patch pairs that did not converge (tolerance mode; zero otherwise).
+    unconverged: u64,
     sphere_area: T,
     face_area: [T; 6],
 }
@@ -172,6 +181,7 @@ fn derive<T: Real>(
         sphere_area,
         face_area: face_area.map(Real::to_f64),
         estimated_error: None,
+        unconverged_pairs: None,
     })
 }
 
@@ -234,6 +244,7 @@ fn paper_sphere_face<T: Real, const CAP: usize>(
     Ok(SpherePart {
         exchange: chunk_sums(&partial, ss.len()),
         error: [T::ZERO; 6],
+        unconverged: 0,
         sphere_area: total_area(&ss),
         face_area,
     })
@@ -278,13 +289,14 @@ fn paper_face_face<T: Real, const CAP: usize>(
 pub const ADAPTIVE_MAX_ORDER: usize = 12;
 
 /// A_a·F_{a→b} for one patch pair in accurate mode: [`pair_exchange`] at the configured orders,
-/// or [`adaptive_exchange`] to the configured tolerance.
+/// or [`adaptive_exchange`] to the configured tolerance: (value, error estimate, 1 if the
+/// estimate did not meet the tolerance else 0).
 fn accurate_pair<T, SA, SB, O, const CAP: usize>(
     cfg: &RunConfig,
     a: &Patch<'_, T, SA>,
     b: &Patch<'_, T, SB>,
     occluders: &O,
-) -> Result<(T, T), PdmError>
+) -> Result<(T, T, u64), PdmError>
 where
     T: Real,
     SA: Surface<T> + ?Sized,
@@ -294,9 +306,10 @@ where
     match cfg.tolerance {
         Some(tol) => {
             let settings = Adaptive { tolerance: T::from_f64(tol), max_order: ADAPTIVE_MAX_ORDER, max_depth: 6 };
-            adaptive_exchange::<T, SA, SB, O, CAP>(a, b, settings, occluders).map(|e| (e.value, e.error))
+            adaptive_exchange::<T, SA, SB, O, CAP>(a, b, settings, occluders)
+                .map(|e| (e.value, e.error, u64::from(!e.converged)))
         }
-        None => pair_exchange::<T, SA, SB, O, CAP>(a, b, settings(cfg), occluders).map(|v| (v, T::ZERO)),
+        None => pair_exchange::<T, SA, SB, O, CAP>(a, b, settings(cfg), occluders).map(|v| (v, T::ZERO, 0)),
     }
 }
 
@@ -331,18 +344,20 @@ fn accurate_sphere_face<T: Real, const CAP: usize>(
     let partial = tasks
         .par_iter()
         .map(|&(ps, face)| {
-            let (mut acc, mut err) = (T::ZERO, T::ZERO);
+            let (mut acc, mut err, mut missed) = (T::ZERO, T::ZERO, 0u64);
             for pf in face {
-                let (v, e) =
+                let (v, e, m) =
                     accurate_pair::<T, _, _, _, CAP>(cfg, ps, pf, &()).map_err(kernel("sphere patch -> face patch"))?;
                 acc += v;
                 err += e;
+                missed += m;
             }
             progress.advance(1);
-            Ok((acc, err))
+            Ok((acc, err, missed))
         })
-        .collect::<Result<Vec<(T, T)>, ValidateError>>()?;
-    let (values, errors): (Vec<T>, Vec<T>) = partial.into_iter().unzip();
+        .collect::<Result<Vec<(T, T, u64)>, ValidateError>>()?;
+    let unconverged = partial.iter().map(|&(_, _, m)| m).sum();
+    let (values, errors): (Vec<T>, Vec<T>) = partial.into_iter().map(|(v, e, _)| (v, e)).unzip();
     let mut face_area = [T::ZERO; 6];
     for (a, f) in face_area.iter_mut().zip(face_patches) {
         *a = areas(f, cfg.order)?;
@@ -350,6 +365,7 @@ fn accurate_sphere_face<T: Real, const CAP: usize>(
     Ok(SpherePart {
         exchange: chunk_sums(&values, sphere_patches.len()),
         error: chunk_sums(&errors, sphere_patches.len()),
+        unconverged,
         sphere_area: areas(sphere_patches, cfg.order)?,
         face_area,
     })
@@ -374,21 +390,23 @@ fn accurate_face_face<T: Real, const CAP: usize>(
     let partial = tasks
         .par_iter()
         .map(|&(pa, face_b)| {
-            let (mut acc, mut err) = (T::ZERO, T::ZERO);
+            let (mut acc, mut err, mut missed) = (T::ZERO, T::ZERO, 0u64);
             for pb in face_b {
-                let (v, e) = accurate_pair::<T, _, _, _, CAP>(cfg, pa, pb, sphere)
+                let (v, e, m) = accurate_pair::<T, _, _, _, CAP>(cfg, pa, pb, sphere)
                     .map_err(kernel("face patch -> face patch"))?;
                 acc += v;
                 err += e;
+                missed += m;
             }
             progress.advance(1);
-            Ok((acc, err))
+            Ok((acc, err, missed))
         })
-        .collect::<Result<Vec<(T, T)>, ValidateError>>()?;
-    let (values, errors): (Vec<T>, Vec<T>) = partial.into_iter().unzip();
+        .collect::<Result<Vec<(T, T, u64)>, ValidateError>>()?;
+    let unconverged = partial.iter().map(|&(_, _, m)| m).sum();
+    let (values, errors): (Vec<T>, Vec<T>) = partial.into_iter().map(|(v, e, _)| (v, e)).unzip();
     let mut face_area = [T::ZERO; 6];
     for (a, f) in face_area.iter_mut().zip(face_patches) {
         *a = areas(f, cfg.order)?;
     }
-    Ok((chunk_sums(&values, per_pair), face_area, chunk_sums(&errors, per_pair)))
+    Ok((chunk_sums(&values, per_pair), face_area, chunk_sums(&errors, per_pair), unconverged))
 }

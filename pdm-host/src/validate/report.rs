@@ -121,6 +121,7 @@ impl Report {
         m.insert("face_to_face".into(), pair_object(&v.face_to_face));
         m.insert("face_sum".into(), json!(v.face_sum));
         m.insert("estimated_error".into(), json!(v.estimated_error));
+        m.insert("unconverged_pairs".into(), json!(v.unconverged_pairs));
         m.insert("reference".into(), self.reference_json());
         let mut ff_err = [0.0; 15];
         for ((e, &ours), &re) in ff_err.iter_mut().zip(&v.face_to_face).zip(&r.face_to_face) {
@@ -456,6 +457,19 @@ impl Report {
                      subdivision limit).",
                     o.precision.name()
                 ));
+            }
+            match o.values.unconverged_pairs {
+                Some(0) => notes.push(format!(
+                    "Tolerance mode ({}): every patch pair converged (estimate within the tolerance).",
+                    o.precision.name()
+                )),
+                Some(n) => notes.push(format!(
+                    "NOT CONVERGED ({}): {n} patch pair(s) stopped above the tolerance (subdivision limit \
+                     or precision floor); their values are the best the settings allow and their \
+                     estimates are included above.",
+                    o.precision.name()
+                )),
+                None => {}
             }
         }
         notes

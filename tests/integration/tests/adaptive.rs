@@ -1,10 +1,19 @@
 //! The tolerance-driven mode: it reaches the tolerance on catalogue cases, its error estimate is
-//! honest (actual error ≤ estimate), and it needs fewer evaluations than uniform refinement.
+//! honest (actual error ≤ estimate), `converged` says whether the tolerance was met, bad
+//! settings are refused, and it needs fewer evaluations than uniform refinement.
+//!
+//! References are independent of the kernel: closed forms from `pdm_host::reference` (C-11,
+//! C-14, the contour integral) or below (C-41), and for the cylinder occluders two
+//! deterministic integrations (below) whose visibility depends on two of the four variables,
+//! so the other two are integrated in closed form; each is checked against a closed form
+//! first (`the_references_reproduce_closed_forms`).
+
+use std::f64::consts::PI;
 
 use pdm_host::reference::{closed_form as exact, contour};
 use pdm_kernel::{
-    adaptive_exchange, surface_form_factor, vec3, Adaptive, Parallelogram, Patch, PatchGrid, PatchSamples, Quadrature,
-    Sphere,
+    adaptive_exchange, surface_form_factor, vec3, Adaptive, Cylinder, Disk, Estimate, Occluder, Parallelogram,
+    ParamRect, Patch, PatchGrid, PatchSamples, PdmError, Quadrature, Side, Sphere, Surface,
 };
 
 fn square(o: [f64; 3], et: [f64; 3], es: [f64; 3]) -> Parallelogram<f64> {
@@ -57,10 +66,18 @@ fn reaches_the_tolerance_with_an_honest_estimate() {
             );
             // Honest: the actual error stays below the estimate (up to rounding, ≈ 1e-13 relative).
             assert!(actual <= e.error + 1e-13 * reference, "{name}: error {actual:e} above its estimate {:e}", e.error);
-            // The 5 % gap pair needs more halvings than the default depth allows below 1e-6;
-            // it stops there with an honest estimate (printed above).
-            let reachable = if name.starts_with("perpendicular, gap") { tol.max(1e-6) } else { tol };
-            assert!(actual <= 10.0 * reachable * reference, "{name}: error {actual:e} misses tolerance {tol:e}");
+            // The 5 % gap pair needs more halvings than the default depth allows below 1e-6,
+            // the near pair below 1e-10; they stop there with an honest estimate and say so.
+            let reachable = match name {
+                n if n.starts_with("perpendicular, gap") => tol >= 1e-6,
+                n if n.starts_with("C-11 near") => tol >= 1e-10,
+                _ => true,
+            };
+            assert_eq!(e.converged, reachable, "{name}, tol {tol:e}: converged = {}", e.converged);
+            if e.converged {
+                assert!(e.error <= tol * e.value, "{name}: converged with estimate {:e}", e.error);
+                assert!(actual <= tol * reference + 1e-13 * reference, "{name}: error {actual:e} misses {tol:e}");
+            }
         }
     }
 }
@@ -136,4 +153,367 @@ fn sphere_to_face_pairs_with_an_honest_estimate() {
     assert!(actual * 6.0 < 1e-6);
     // The estimate bounds the integration error; the areas by eq. (12) add ≈ 1e-15.
     assert!(actual <= estimate / area + 1e-14, "estimate not honest");
+}
+// ---------------------------------------------------------------------------------------------
+// Independent references (share no code with the kernel): Gauss–Legendre nodes by Newton's
+// iteration on the Legendre recurrence, and two geometries whose visibility depends on two
+// of the four variables only, so the other two are integrated in closed form.
+
+/// n-point Gauss–Legendre nodes and weights on [-1, 1] (Newton on P_n, Golub–Welsch start).
+fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
+    (0..n)
+        .map(|i| {
+            let mut x = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
+            let mut dp = 0.0;
+            for _ in 0..100 {
+                let (mut p0, mut p1) = (1.0, x);
+                for k in 2..=n {
+                    let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
+                    p0 = p1;
+                    p1 = p2;
+                }
+                dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
+                let dx = p1 / dp;
+                x -= dx;
+                if dx.abs() < 1e-16 {
+                    break;
+                }
+            }
+            (x, 2.0 / ((1.0 - x * x) * dp * dp))
+        })
+        .collect()
+}
+
+/// ∫ f over [lo, hi], cut at the sorted points `cuts` inside it, each piece by 40-point Gauss.
+fn integrate(f: &dyn Fn(f64) -> f64, lo: f64, hi: f64, cuts: &[f64], rule: &[(f64, f64)]) -> f64 {
+    let mut ends: Vec<f64> = cuts.iter().copied().filter(|&c| c > lo && c < hi).collect();
+    ends.push(lo);
+    ends.push(hi);
+    ends.sort_by(f64::total_cmp);
+    ends.windows(2)
+        .map(|w| {
+            let (m, h) = ((w[0] + w[1]) / 2.0, (w[1] - w[0]) / 2.0);
+            rule.iter().map(|&(x, wt)| wt * h * f(m + h * x)).sum::<f64>()
+        })
+        .sum()
+}
+
+/// ∫_{[a0,a1]} ∫_{[b0,b1]} (c + (u − v)²)⁻² dv du, from the double antiderivative of
+/// (c + w²)⁻², F₂(w) = w·atan(w/√c) / (2 c^{3/2}).
+fn double_z(c: f64, (a0, a1): (f64, f64), (b0, b1): (f64, f64)) -> f64 {
+    let f2 = |w: f64| w * (w / c.sqrt()).atan() / (2.0 * c.powf(1.5));
+    f2(a1 - b0) - f2(a0 - b0) - f2(a1 - b1) + f2(a0 - b1)
+}
+
+/// Unit squares z = 0 (facing up) and z = 1 (facing down) over [0, 1]², with a long cylinder of
+/// radius `r` parallel to y through (cx, ·, cz) between them (r < cz < 1 − r). Visibility
+/// depends on x₁, x₂ only (the segment's projection on the xz-plane must miss the circle), the
+/// kernel 1/(π L⁴) with L² = 1 + (x₁−x₂)² + (y₁−y₂)², so
+/// F = (1/π) ∫∫_visible G(1 + (x₁−x₂)²) dx₂ dx₁ with G the closed-form y-integral; the
+/// shadow in x₂ is bounded by the tangents from (x₁, 0) to the circle (a quadratic).
+/// `r = 0` gives C-11 (checked).
+fn squares_with_cylinder(cx: f64, cz: f64, r: f64) -> f64 {
+    let rule = gauss_legendre(40);
+    let shadow = |x1: f64| -> Option<(f64, f64)> {
+        if r == 0.0 {
+            return None;
+        }
+        // Blocked where (d·cz − u)² < r²(d² + 1), d = x₂ − x₁, u = cx − x₁.
+        let u = cx - x1;
+        let a = cz * cz - r * r;
+        let disc = (r * r * (cz * cz + u * u - r * r)).sqrt();
+        Some((x1 + (cz * u - disc) / a, x1 + (cz * u + disc) / a))
+    };
+    let inner = |x1: f64| {
+        let g = |x2: f64| double_z(1.0 + (x1 - x2).powi(2), (0.0, 1.0), (0.0, 1.0));
+        match shadow(x1) {
+            None => integrate(&g, 0.0, 1.0, &[], &rule),
+            Some((lo, hi)) => {
+                integrate(&g, 0.0, lo.clamp(0.0, 1.0), &[], &rule) + integrate(&g, hi.clamp(0.0, 1.0), 1.0, &[], &rule)
+            }
+        }
+    };
+    // The outer kinks: x₁ where a shadow edge crosses x₂ = 0 or 1 (bisection on a fine grid).
+    let mut kinks = Vec::new();
+    if r > 0.0 {
+        for edge in [0.0, 1.0] {
+            for side in [0, 1] {
+                let h = |x1: f64| {
+                    let (lo, hi) = shadow(x1).unwrap();
+                    (if side == 0 { lo } else { hi }) - edge
+                };
+                let n = 400;
+                for k in 0..n {
+                    let (mut a, mut b) = (k as f64 / n as f64, (k + 1) as f64 / n as f64);
+                    if h(a).signum() == h(b).signum() {
+                        continue;
+                    }
+                    for _ in 0..200 {
+                        let m = (a + b) / 2.0;
+                        if h(m).signum() == h(a).signum() {
+                            a = m;
+                        } else {
+                            b = m;
+                        }
+                    }
+                    kinks.push((a + b) / 2.0);
+                }
+            }
+        }
+    }
+    integrate(&inner, 0.0, 1.0, &kinks, &rule) / std::f64::consts::PI
+}
+
+/// A_a·F_{a→b} between patches θ ∈ `ta`, `tb` (whole height h) of the inside of a cylinder of
+/// radius `big`, with a coaxial tube of radius `small` occluding over the whole height. A segment
+/// between two points of the outer wall misses the tube iff its chord distance from the axis,
+/// big·cos(Δ/2), is ≥ small (Δ = θ₁ − θ₂ wrapped to [−π, π]); the kernel is
+/// big²(1 − cos Δ)²/(π L⁴) with L² = 2 big²(1 − cos Δ) + (z₁−z₂)², integrated over z in closed
+/// form. Cuts: Δ = 0 (a kink), the shadow edges ±Δ_max and their 2π images, inside and outside.
+fn cylinder_wall_pair(big: f64, small: f64, h: f64, ta: (f64, f64), tb: (f64, f64)) -> f64 {
+    use std::f64::consts::PI;
+    let rule = gauss_legendre(40);
+    let dmax = if small > 0.0 { 2.0 * (small / big).acos() } else { PI };
+    let offsets = [0.0, dmax, -dmax, 2.0 * PI - dmax, dmax - 2.0 * PI, 2.0 * PI, -2.0 * PI];
+    let kernel = |d: f64| {
+        let one_minus_cos = 2.0 * (d / 2.0).sin().powi(2);
+        let c = 2.0 * big * big * one_minus_cos;
+        if c == 0.0 {
+            return 0.0;
+        }
+        let w = d.rem_euclid(2.0 * PI);
+        let w = if w > PI { w - 2.0 * PI } else { w };
+        if w.abs() > dmax {
+            return 0.0;
+        }
+        big * big * one_minus_cos.powi(2) / PI * double_z(c, (0.0, h), (0.0, h)) * big * big
+    };
+    let inner = |t1: f64| {
+        let cuts: Vec<f64> = offsets.iter().map(|o| t1 + o).collect();
+        integrate(&|t2| kernel(t1 - t2), tb.0, tb.1, &cuts, &rule)
+    };
+    let mut cuts = Vec::new();
+    for o in offsets {
+        cuts.push(tb.0 - o);
+        cuts.push(tb.1 - o);
+    }
+    integrate(&inner, ta.0, ta.1, &cuts, &rule)
+}
+
+/// C-41 (Howell's catalogue): coaxial parallel disks of radii r₁ → r₂ at distance h,
+/// F = ½ (X − √(X² − 4 (r₂/r₁)²)), X = 1 + (1 + R₂²)/R₁², Rᵢ = rᵢ/h.
+fn coaxial_disks(r1: f64, r2: f64, h: f64) -> f64 {
+    let (a, b) = (r1 / h, r2 / h);
+    let x = 1.0 + (1.0 + b * b) / (a * a);
+    0.5 * (x - (x * x - 4.0 * (b / a).powi(2)).sqrt())
+}
+
+/// Checks one tolerance-mode result against its reference: value within the physical bounds,
+/// actual error ≤ estimate (+ `slack`·reference for the reference's and the areas' rounding),
+/// and `converged` exactly when the estimate meets the tolerance (then so does the error).
+fn check(name: &str, e: &Estimate<f64>, reference: f64, tol: f64, bound: f64, slack: f64) -> f64 {
+    let actual = (e.value - reference).abs();
+    println!(
+        "{name}, tol {tol:.0e}: actual {:.2e}, estimate {:.2e} (ratio {:.2}), converged {}, {} evaluations",
+        actual / reference,
+        e.error / reference,
+        actual / e.error,
+        e.converged,
+        e.evaluations
+    );
+    assert!(e.value >= 0.0 && e.value <= bound, "{name}: {} outside [0, {bound}]", e.value);
+    assert!(
+        actual <= e.error + slack * reference,
+        "{name}, tol {tol:e}: error {actual:e} above estimate {:e}",
+        e.error
+    );
+    if e.converged {
+        assert!(e.error <= tol * e.value, "{name}, tol {tol:e}: converged with estimate {:e}", e.error);
+        assert!(actual <= (tol + slack) * reference, "{name}: converged but error {actual:e} misses {tol:e}");
+    }
+    actual / reference
+}
+
+const TOLERANCES: [f64; 7] = [1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8];
+
+#[test]
+fn the_references_reproduce_closed_forms() {
+    // Without the cylinder the squares' reference is C-11.
+    let c11 = exact::parallel_rectangles(1.0, 1.0, 1.0);
+    assert!((squares_with_cylinder(0.5, 0.5, 0.0) - c11).abs() < 1e-14 * c11);
+    // Without the inner tube, the inside of a tube of radius 1 and height 1 sees itself with
+    // F = 1 − 2 F_wall→end, F_wall→end = r (1 − F_end→end) / (2 h) (reciprocity, C-41).
+    let f_ends = coaxial_disks(1.0, 1.0, 1.0);
+    let f_ww = 1.0 - 2.0 * (1.0 - f_ends) / 2.0;
+    let ours = cylinder_wall_pair(1.0, 0.0, 1.0, (0.0, 2.0 * PI), (0.0, 2.0 * PI)) / (2.0 * PI);
+    assert!((ours - f_ww).abs() < 1e-13, "{ours} vs {f_ww}");
+}
+
+#[test]
+fn whole_coaxial_disks_converge_to_the_tolerance() {
+    // Two whole disks (one patch each, θ over the full circle): a chord-measuring splitter never
+    // halved θ and stalled at 2.4e-4 for every tolerance. Reference: C-41.
+    let lower = Disk::new(vec3(0.0, 0.0, 0.0), vec3(0.0, 0.0, 1.0), 1.0).unwrap();
+    let upper = Disk::new(vec3(0.0, 0.0, 1.0), vec3(0.0, 0.0, -1.0), 1.0).unwrap();
+    let (pa, pb) = (Patch::whole(&lower).unwrap(), Patch::whole(&upper).unwrap());
+    let reference = PI * coaxial_disks(1.0, 1.0, 1.0);
+    for tol in TOLERANCES.into_iter().chain([1e-10]) {
+        let e = adaptive_exchange::<f64, _, _, _, 144>(&pa, &pb, Adaptive::new(tol), &()).unwrap();
+        check("whole coaxial disks", &e, reference, tol, PI, 1e-13);
+        assert!(e.converged, "tol {tol:e}: not converged");
+    }
+}
+
+fn tolerance_sweep<SA: Surface<f64>, SB: Surface<f64>, O: Occluder<f64>>(
+    name: &str,
+    a: &Patch<'_, f64, SA>,
+    b: &Patch<'_, f64, SB>,
+    occluders: &O,
+    reference: f64,
+    tolerances: &[f64],
+) -> Vec<Estimate<f64>> {
+    let bound = a.area(16).unwrap().min(b.area(16).unwrap());
+    tolerances
+        .iter()
+        .map(|&tol| {
+            let e = adaptive_exchange::<f64, _, _, _, 144>(a, b, Adaptive::new(tol), occluders).unwrap();
+            check(name, &e, reference, tol, bound, 1e-13);
+            e
+        })
+        .collect()
+}
+
+#[test]
+fn cylinder_between_parallel_squares() {
+    // Unit squares at z = 0 and 1 with a long tube (radius 0.25, axis along y) between them:
+    // no closed-form polynomials, the inner rule brackets and bisects; the outer integrand has
+    // kinks where the shadow's edges cross the receiver's. The estimate used to be below the
+    // actual error by up to 3× on such pairs; nothing said the tolerance was missed.
+    let a = Parallelogram::new(vec3(0.0, 0.0, 0.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0)).unwrap();
+    let b = Parallelogram::new(vec3(0.0, 0.0, 1.0), vec3(0.0, 1.0, 0.0), vec3(1.0, 0.0, 0.0)).unwrap();
+    for (cx, cz, r) in [(0.5, 0.5, 0.25), (0.3, 0.4, 0.2)] {
+        let tube = Cylinder::new(vec3(cx, -1.0, cz), vec3(0.0, 1.0, 0.0), r, 3.0, Side::Outer).unwrap();
+        let reference = squares_with_cylinder(cx, cz, r);
+        let name = format!("squares, tube r {r} at ({cx}, {cz})");
+        let (pa, pb) = (Patch::whole(&a).unwrap(), Patch::whole(&b).unwrap());
+        tolerance_sweep(&name, &pa, &pb, &tube, reference, &TOLERANCES);
+    }
+}
+
+fn tubes(small: f64) -> (Cylinder<f64>, Cylinder<f64>) {
+    let outer = Cylinder::new(vec3(0.0, 0.0, 0.0), vec3(0.0, 0.0, 1.0), 1.0, 1.0, Side::Inner).unwrap();
+    let inner = Cylinder::new(vec3(0.0, 0.0, -0.1), vec3(0.0, 0.0, 1.0), small, 1.2, Side::Outer).unwrap();
+    (outer, inner)
+}
+
+#[test]
+fn wall_pair_inside_a_tube_around_a_coaxial_tube() {
+    // Two quarter walls of the inside of a tube (radius 1, height 1), a coaxial tube of radius
+    // 0.5 occluding.
+    let (outer, inner) = tubes(0.5);
+    let (ta, tb) = ((0.0, PI / 2.0), (PI / 2.0, PI));
+    let pa = Patch::new(&outer, ParamRect::new(ta.0, ta.1, 0.0, 1.0).unwrap()).unwrap();
+    let pb = Patch::new(&outer, ParamRect::new(tb.0, tb.1, 0.0, 1.0).unwrap()).unwrap();
+    let reference = cylinder_wall_pair(1.0, 0.5, 1.0, ta, tb);
+    tolerance_sweep("tube walls, coaxial tube", &pa, &pb, &inner, reference, &[1e-2, 1e-4, 1e-6, 1e-8]);
+}
+
+#[test]
+fn self_pair_inside_a_tube() {
+    // The inside of a tube against itself (the `Identical` path), with and without a coaxial
+    // tube occluding. The plain self rule converges algebraically, and with the occluder its
+    // error oscillates from order to order; the estimate compared orders p and p − 2 only and
+    // was 1.2× below the actual error. Self pairs are not subdivided: above the tolerance
+    // they say so.
+    let (outer, inner) = tubes(0.5);
+    let t = (0.0, 1.5 * PI);
+    let patch = Patch::new(&outer, ParamRect::new(t.0, t.1, 0.0, 1.0).unwrap()).unwrap();
+    let reference = cylinder_wall_pair(1.0, 0.5, 1.0, t, t);
+    let e = tolerance_sweep("tube wall self, coaxial tube", &patch, &patch, &inner, reference, &TOLERANCES);
+    assert!(e.iter().all(|e| !e.converged));
+    let t = (0.0, PI / 2.0);
+    let quarter = Patch::new(&outer, ParamRect::new(t.0, t.1, 0.0, 1.0).unwrap()).unwrap();
+    let reference = cylinder_wall_pair(1.0, 0.0, 1.0, t, t);
+    let e = tolerance_sweep("quarter tube wall self", &quarter, &quarter, &(), reference, &[1e-2, 1e-3]);
+    assert!(e[0].converged && !e[1].converged, "{e:?}");
+    // A higher max_order reaches 1e-3.
+    let high = Adaptive { max_order: 32, ..Adaptive::new(1e-3) };
+    let e = adaptive_exchange::<f64, _, _, _, 1024>(&quarter, &quarter, high, &()).unwrap();
+    check("quarter tube wall self, max order 32", &e, reference, 1e-3, quarter.area(16).unwrap(), 1e-13);
+    assert!(e.converged, "{e:?}");
+}
+
+#[test]
+fn bad_settings_are_refused() {
+    let a = Parallelogram::new(vec3(0.0, 0.0, 0.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0)).unwrap();
+    let b = Parallelogram::new(vec3(0.0, 0.0, 1.0), vec3(0.0, 1.0, 0.0), vec3(1.0, 0.0, 0.0)).unwrap();
+    let (pa, pb) = (Patch::whole(&a).unwrap(), Patch::whole(&b).unwrap());
+    let run = |s: Adaptive<f64>| adaptive_exchange::<f64, _, _, _, 1024>(&pa, &pb, s, &());
+    let setting = |r: Result<Estimate<f64>, PdmError>| match r {
+        Err(PdmError::InvalidSetting { name, .. }) => name,
+        other => panic!("expected InvalidSetting, got {other:?}"),
+    };
+    for tol in [0.0, -1e-6, f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+        assert_eq!(setting(run(Adaptive::new(tol))), "tolerance", "tolerance {tol}");
+    }
+    for max_order in [0, 7, 33, 1000] {
+        assert_eq!(setting(run(Adaptive { max_order, ..Adaptive::new(1e-6) })), "max_order", "{max_order}");
+    }
+    assert_eq!(setting(run(Adaptive { max_depth: 25, ..Adaptive::new(1e-6) })), "max_depth");
+    for max_order in [8, 32] {
+        assert!(run(Adaptive { max_order, ..Adaptive::new(1e-6) }).is_ok(), "max_order {max_order}");
+    }
+    // The sample buffers need max_order² points.
+    let small = adaptive_exchange::<f64, _, _, _, 143>(&pa, &pb, Adaptive::new(1e-6), &());
+    assert_eq!(small, Err(PdmError::CapacityExceeded { needed: 144, capacity: 143 }));
+    assert!(adaptive_exchange::<f64, _, _, _, 144>(&pa, &pb, Adaptive::new(1e-6), &()).is_ok());
+}
+
+#[test]
+fn limits_are_reported_as_not_converged() {
+    // The depth limit: perpendicular squares 5 % apart need more halvings than depth 1 allows.
+    let floor = square([0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]);
+    let wall = square([0.0, 0.0, 0.05], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]);
+    let (pa, pb) = (Patch::whole(&floor).unwrap(), Patch::whole(&wall).unwrap());
+    let shallow = Adaptive { max_depth: 1, ..Adaptive::new(1e-8) };
+    let e = adaptive_exchange::<f64, _, _, _, 144>(&pa, &pb, shallow, &()).unwrap();
+    assert!(!e.converged && e.error > 1e-8 * e.value, "{e:?}");
+    // The precision floor: f32 cannot deliver 1e-7 (the rounding allowance is 128 ε = 1.5e-5).
+    let a = Parallelogram::new(vec3(0.0f32, 0.0, 0.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0)).unwrap();
+    let b = Parallelogram::new(vec3(0.0f32, 0.0, 1.0), vec3(0.0, 1.0, 0.0), vec3(1.0, 0.0, 0.0)).unwrap();
+    let (pa, pb) = (Patch::whole(&a).unwrap(), Patch::whole(&b).unwrap());
+    let reference = exact::parallel_rectangles(1.0, 1.0, 1.0);
+    for (tol, converged) in [(1e-3f32, true), (1e-4, true), (1e-5, false), (1e-7, false)] {
+        let e = adaptive_exchange::<f32, _, _, _, 144>(&pa, &pb, Adaptive::new(tol), &()).unwrap();
+        let actual = (f64::from(e.value) - reference).abs();
+        println!(
+            "f32 C-11, tol {tol:.0e}: actual {:.2e}, estimate {:.2e}, converged {}",
+            actual / reference,
+            f64::from(e.error) / reference,
+            e.converged
+        );
+        assert_eq!(e.converged, converged, "f32 tol {tol:e}");
+        assert!(actual <= f64::from(e.error), "f32 tol {tol:e}: error {actual:e} above estimate {:e}", e.error);
+    }
+}
+
+#[test]
+#[ignore = "needs boundary.rs zero-normal fix (inner patch edge with zero normal: sphere pole, disk centre)"]
+fn sphere_to_coaxial_disk() {
+    // Sphere of radius 0.5 centred at distance 1 above a disk of radius 1 facing it:
+    // F_sphere→disk = ½ (1 − 1/√(1 + (a/h)²)) (sphere to coaxial disk, Howell's catalogue).
+    let sphere = Sphere::outer(vec3(0.0, 0.0, 1.0), 0.5).unwrap();
+    let disk = Disk::new(vec3(0.0, 0.0, 0.0), vec3(0.0, 0.0, 1.0), 1.0).unwrap();
+    let reference = PI * 0.5 * 0.5 * 4.0 * 0.5 * (1.0 - 1.0 / 2f64.sqrt());
+    let pd = Patch::whole(&disk).unwrap();
+    for tol in [1e-3, 1e-6, 1e-8] {
+        let mut total = Estimate { value: 0.0, error: 0.0, converged: true, evaluations: 0 };
+        for ps in PatchGrid::new(&sphere, 4, 4).unwrap() {
+            let e = adaptive_exchange::<f64, _, _, _, 144>(&ps, &pd, Adaptive::new(tol), &()).unwrap();
+            total.value += e.value;
+            total.error += e.error;
+            total.converged &= e.converged;
+        }
+        check("sphere -> coaxial disk", &total, reference, tol, PI, 1e-13);
+    }
 }
