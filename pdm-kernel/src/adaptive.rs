@@ -184,7 +184,12 @@ where
     if needed > CAP {
         return Err(PdmError::CapacityExceeded { needed, capacity: CAP });
     }
-    let mut e = recurse::<T, SA, SB, O, CAP>(a, b, settings, occluders, 0)?;
+    // Closed patches are cut at their seams first, as in `pair_exchange`.
+    let mut e = Estimate::zero(0);
+    crate::pair::for_each_piece_pair(a, b, |pa, pb| {
+        e.add(recurse::<T, SA, SB, O, CAP>(pa, pb, settings, occluders, 0)?);
+        Ok(())
+    })?;
     let (area_a, area_b) = (a.area(settings.max_order)?, b.area(settings.max_order)?);
     e.value = crate::bounds::exchange(e.value, area_a, area_b)?;
     if !e.error.is_finite() {
@@ -207,6 +212,20 @@ where
     O: Occluder<T> + ?Sized,
 {
     let (adjacency, gap) = classify_near(a, b);
+    // Two flat patches that see each other wholly: the contour form at two orders.
+    #[cfg(feature = "closed-form")]
+    if adjacency == Adjacency::Separate || (adjacency != Adjacency::Identical && gap > T::ZERO) {
+        let lo_order = 8usize.min(settings.max_order);
+        if let Some(lo) = crate::pair::flat_pair(a, b, lo_order, occluders) {
+            let (lo, n_lo, _) = lo?;
+            let hi_order = (2 * lo_order).min(settings.max_order.max(lo_order + 1));
+            if let Some(hi) = crate::pair::flat_pair(a, b, hi_order, occluders) {
+                let (hi, n_hi, rounding) = hi?;
+                let difference = (hi - lo).abs() + rounding;
+                return Ok(Estimate::leaf(hi, difference, settings.tolerance, n_lo.saturating_add(n_hi)));
+            }
+        }
+    }
     match adjacency {
         Adjacency::SharedEdge { .. } | Adjacency::SharedVertex { .. } => {
             // The transforms test occlusion only at their sample points: with an occluder that

@@ -32,7 +32,8 @@ use crate::vec3::Vec3;
 /// Most geometric cuts towards one singular point (4^24 ≈ 3e14: any gap above rounding).
 const MAX_LEVELS: usize = 26;
 
-/// A_a·F_{a→b} and the number of line-integrand evaluations, for two flat convex quadrilaterals
+/// A_a·F_{a→b}, the number of line-integrand evaluations and a bound on the rounding error of
+/// the value, for two flat convex quadrilaterals
 /// given by their corners in order, counter-clockwise about their radiating normals, each
 /// wholly in front of (or on) the other's plane and with no occluder between them.
 ///
@@ -40,7 +41,11 @@ const MAX_LEVELS: usize = 26;
 /// thin strips they cancel by many digits. The rounding of the sum is bounded by 8ε times the
 /// sum of the terms' magnitudes; where that bound exceeds √ε of the value (1.5e-8 in f64) the
 /// pair is refused with `Err(Unresolvable)` rather than returned with lost digits.
-pub(crate) fn quad_exchange<T: Real>(a: &[Vec3<T>; 4], b: &[Vec3<T>; 4], order: usize) -> Result<(T, u64), PdmError> {
+pub(crate) fn quad_exchange<T: Real>(
+    a: &[Vec3<T>; 4],
+    b: &[Vec3<T>; 4],
+    order: usize,
+) -> Result<(T, u64, T), PdmError> {
     let rule = GaussRule::<T>::new(order)?;
     // Centroid to the origin, largest distance to 1.
     let mut centroid = crate::vec3::vec3(T::ZERO, T::ZERO, T::ZERO);
@@ -80,10 +85,12 @@ pub(crate) fn quad_exchange<T: Real>(a: &[Vec3<T>; 4], b: &[Vec3<T>; 4], order: 
     if !total.is_finite() {
         return Err(PdmError::InvalidResult);
     }
-    if T::from_f64(8.0) * T::EPSILON * magnitude > T::EPSILON.sqrt() * total.abs() {
+    let rounding = T::from_f64(8.0) * T::EPSILON * magnitude;
+    if rounding > T::EPSILON.sqrt() * total.abs() {
         return Err(PdmError::Unresolvable);
     }
-    Ok((total * size * size * T::FRAC_1_PI * T::HALF, evaluations))
+    let scale = size * size * T::FRAC_1_PI * T::HALF;
+    Ok((total * scale, evaluations, rounding * scale))
 }
 
 /// ∫₀¹∫₀¹ ln |P + σ d_a − Q − τ d_b| dτ dσ (see the module docs), the same integral of the
@@ -262,7 +269,7 @@ mod tests {
         for h in [1.0, 1e-1, 1e-3, 1e-6, 1e-8] {
             let lower = [vec3(0.0, 0.0, 0.0), vec3(1.0, 0.0, 0.0), vec3(1.0, 1.0, 0.0), vec3(0.0, 1.0, 0.0)];
             let upper = [vec3(0.0, 0.0, h), vec3(0.0, 1.0, h), vec3(1.0, 1.0, h), vec3(1.0, 0.0, h)];
-            let (f, _) = quad_exchange::<f64>(&lower, &upper, 10).unwrap();
+            let (f, _, _) = quad_exchange::<f64>(&lower, &upper, 10).unwrap();
             let exact = c11(h);
             // The closed form's terms grow like 1/h² and cancel to O(1): it keeps about
             // ε/h² digits less, 1e-10 at h = 1e-8.

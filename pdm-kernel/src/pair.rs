@@ -221,7 +221,7 @@ where
     if settings.boundaries && (adjacency == Adjacency::Separate || (adjacency != Adjacency::Identical && gap > T::ZERO))
     {
         if let Some(result) = flat_pair(a, b, settings.order, occluders) {
-            return result;
+            return result.map(|(value, count, _)| (value, count));
         }
     }
     match adjacency {
@@ -326,22 +326,20 @@ fn is_flat<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>) -> bool {
     let (lo, hi) = (T::from_f64(0.125), T::from_f64(0.875));
     let Some(centre) = at(T::HALF, T::HALF) else { return false };
     let limit = T::ONE - T::from_f64(64.0) * T::EPSILON;
-    [(lo, lo), (hi, lo), (lo, hi), (hi, hi)]
-        .iter()
-        .all(|&(x, y)| at(x, y).is_some_and(|n| n.dot(centre) >= limit))
+    [(lo, lo), (hi, lo), (lo, hi), (hi, hi)].iter().all(|&(x, y)| at(x, y).is_some_and(|n| n.dot(centre) >= limit))
 }
 
 /// Two flat patches (parallelograms) that see each other wholly — each in the closed half-space
 /// in front of the other, not coplanar, no occluder able to cut a segment between them — by the
 /// contour form ([`crate::contour`]), exact at any gap and aspect ratio; `None` if the pair is
-/// not such a pair.
+/// not such a pair. Gives the value, the evaluations and a bound on the value's rounding error.
 #[cfg(feature = "closed-form")]
-fn flat_pair<T, SA, SB, O>(
+pub(crate) fn flat_pair<T, SA, SB, O>(
     a: &Patch<'_, T, SA>,
     b: &Patch<'_, T, SB>,
     order: usize,
     occluders: &O,
-) -> Option<Result<(T, u64), PdmError>>
+) -> Option<Result<(T, u64, T), PdmError>>
 where
     T: Real,
     SA: Surface<T> + ?Sized,
