@@ -498,7 +498,6 @@ fn limits_are_reported_as_not_converged() {
 }
 
 #[test]
-#[ignore = "needs boundary.rs zero-normal fix (inner patch edge with zero normal: sphere pole, disk centre)"]
 fn sphere_to_coaxial_disk() {
     // Sphere of radius 0.5 centred at distance 1 above a disk of radius 1 facing it:
     // F_sphere→disk = ½ (1 − 1/√(1 + (a/h)²)) (sphere to coaxial disk, Howell's catalogue).
