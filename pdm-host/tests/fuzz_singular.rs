@@ -1380,3 +1380,29 @@ fn adaptive_nearly_folded_separate_pair_is_refused() {
     let e = e.unwrap();
     assert!((e.value - reference).abs() <= e.error, "{e:?} vs {reference}");
 }
+
+/// Open (adaptive.rs's estimate for touching pairs, the difference of orders 6 and 8), found by
+/// the adaptive property's long run (seed 20260601, case 90, shrunk): floor 0.761 × 1 and flap
+/// 0.761 × 0.935 sharing an edge at 28.6°, tolerance 1e-3: value 0.44385973468 against the
+/// contour 0.44385973829, actual error 3.6e-9 > estimate 1.1e-9 (32352 evaluations: orders 6
+/// and 8). Prints the touching transform's error per order; asserts the correct behaviour.
+#[test]
+#[ignore = "open: the tolerance mode's estimate on a touching pair is below the actual error"]
+fn adaptive_touching_pair_estimate_below_the_actual_error() {
+    let case = plain_case(28.569596826911052, 0.760867382867785, 1.0, 0.9350669727448926, 0.0);
+    let (floor, flap) = case.build::<f64>().unwrap();
+    let (a, b) = (floor.cell(0, 1), flap.cell(0, 1));
+    let (pf, pp) = case.polygons();
+    let reference = contour::polygon_form_factor(&pf, &pp) * case.l * case.w;
+    let (near, gap) = classify_near(&a, &b);
+    for order in [4, 6, 8, 10, 12, 16, 20] {
+        let x = touching_exchange(&a, &b, near, gap, order, &()).unwrap();
+        println!("order {order}: {x:.16e}, error {:+.2e}", x - reference);
+    }
+    let e =
+        adaptive_exchange::<f64, _, _, _, 256>(&a, &b, Adaptive { tolerance: 1e-3, max_order: 12, max_depth: 4 }, &())
+            .unwrap();
+    let actual = (e.value - reference).abs();
+    println!("adaptive: {e:?}, actual error {actual:.2e}");
+    assert!(actual <= e.error, "actual {actual:e} > estimate {:e}", e.error);
+}
