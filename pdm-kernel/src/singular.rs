@@ -310,8 +310,16 @@ where
     // The geometry is resolved when the rounding band is small against every edge (times the
     // fold parameter for an edge pair); otherwise a contact found is reported with the gap `T::MAX`
     // (refused by touching_exchange).
+    // Each patch as a whole must be resolved too: edges below the tight tolerance are skipped
+    // as collapsed (a pole), so a patch smaller than the rounding of its coordinates (a sphere of
+    // radius 2.5e-29 at x = −85, `cargo fuzz`) would otherwise pass on the other patch's edges
+    // alone and send rounding noise through the graded transforms (a 30 s timeout).
+    let smallest_patch = diameter(&ca).min(diameter(&cb));
     let flag = |adjacency: Adjacency, gap: T, sensitivity: T| {
-        let resolved = shortest < T::MAX && band <= T::from_f64(RESOLUTION) * shortest * sensitivity.min(T::ONE);
+        let resolution = T::from_f64(RESOLUTION);
+        let resolved = shortest < T::MAX
+            && band <= resolution * shortest * sensitivity.min(T::ONE)
+            && band <= resolution * smallest_patch;
         if resolved {
             (adjacency, gap)
         } else {
