@@ -6,7 +6,11 @@
 //! `pair_exchange(b, a)` are computed: they go through different local maps); f32 agrees with
 //! f64; planar pairs agree with the independent contour-integral reference
 //! (`pdm_host::reference::contour`), curved pairs with closed forms. Adjacency detection
-//! (`classify`, `classify_near`) and `touching_exchange` are exercised directly.
+//! (`classify`, `classify_near`) and `touching_exchange` are exercised directly. Every value an
+//! entry point returns is checked against the physical bounds 0 ≤ A_a·F_ab ≤ min(A_a, A_b)
+//! (`assert_bounds`); the tolerance mode (`adaptive_exchange`) on touching, nearly touching and
+//! separate flat pairs, both argument orders: bounds, and its estimate ≥ the actual error
+//! against the contour reference unless it did not converge (issue 11 item 6).
 //!
 //! Deterministic: proptest with a fixed ChaCha seed and no failure persistence. Case count per
 //! property: `PDM_FUZZ_CASES` (default: each property's CI count, below; the file runs in
@@ -1405,4 +1409,76 @@ fn adaptive_touching_pair_estimate_below_the_actual_error() {
     let actual = (e.value - reference).abs();
     println!("adaptive: {e:?}, actual error {actual:.2e}");
     assert!(actual <= e.error, "actual {actual:e} > estimate {:e}", e.error);
+}
+
+/// From `cargo fuzz` (issue 11 run, a 30 s timeout): a whole outer sphere of radius 2.5e-29
+/// centred at (−85, −1.8e-4, 4.3e-39) — smaller than the rounding of its coordinates — and a
+/// parallelogram on its two poles (corners 0 and 3) with the other side (−105, −105, −105),
+/// reversed; orders 7. `touching_exchange` on the vertex contact spent the time in
+/// `vertex_sum`'s nested gradings (widths at their 1e-12 floor: rounding noise). Fixed: a
+/// contact is resolved only if each patch as a whole is (`Err(Degenerate)` here).
+#[test]
+fn fuzz_sphere_below_the_rounding_of_its_coordinates() {
+    let center = vec3(-85.0, -6169.0 * 2f64.powi(-25), f64::from(f32::from_bits(3_101_780)));
+    let sphere = Sphere::outer(center, f64::from(f32::from_bits(268_457_044))).unwrap();
+    let a = Patch::whole(&sphere).unwrap();
+    let r = a.rect();
+    let (p, q) = (sphere.point(r.t0, r.s0), sphere.point(r.t1, r.s1));
+    let quad = Parallelogram::new(p, q - p, vec3(-105.0, -105.0, -105.0)).unwrap().reversed();
+    let b = Patch::whole(&quad).unwrap();
+    let (near, gap) = classify_near(&a, &b);
+    println!("classify_near {near:?}, gap {gap:e}");
+    let start = std::time::Instant::now();
+    let x = touching_exchange(&a, &b, near, gap, 7, &());
+    let y = pair_exchange::<f64, _, _, _, 64>(&a, &b, settings(7, 7), &());
+    let z = pair_exchange::<f64, _, _, _, 64>(&b, &a, settings(7, 7), &());
+    let t = start.elapsed().as_secs_f64();
+    println!("{x:?} / {y:?} / {z:?} in {t:.2} s");
+    for v in [x, y, z] {
+        assert!(v.map_or(true, |v| v.is_finite() && v >= 0.0), "{v:?}");
+    }
+    assert!(t < 1.0, "{t} s");
+}
+
+/// Finding 16 (edge property, seed 20261201, case 34): 1545 unit cells along an edge folded to
+/// 1° with a gap of 1e-3, far from the origin: 1.27e-7 off the contour (1e-9 allowed); the
+/// property saw 4.5e-10 reciprocity between neighbouring cells. Suspected: the vertex transform does not grade
+/// ζ towards the gap (finding 12 in the edge transform) — ruled out: a trial grading there left
+/// F unchanged to all digits, and the vertex cells are 6.4e-13 from reciprocal. Open.
+#[test]
+#[ignore = "open: finding 16, cause not found"]
+fn seed_20261201_cells_along_an_edge_folded_to_1_degree_with_a_gap() {
+    let case = EdgeCase {
+        theta_deg: 1.0,
+        l: 1545.1283354437887,
+        w: 1.0,
+        h: 1.0,
+        gap: 0.001,
+        motion: (
+            0.07435193319503826,
+            0.47360582701575427,
+            1.377270038731309,
+            6.030323589296109,
+            [-2.3295145103358683, -9.909084458994052, -8.056785610297707],
+        ),
+        variant_floor: 2,
+        variant_flap: 7,
+    };
+    let (floor, flap) = case.build::<f64>().unwrap();
+    let n = case.cells();
+    let m = case.motion();
+    let start = std::time::Instant::now();
+    let f = edge_sum(&floor, &flap, n, 16).unwrap() / (case.l * case.w * m.scale * m.scale);
+    let (pf, pp) = case.polygons();
+    let reference = contour::polygon_form_factor(&pf, &pp);
+    let (a, b) = (floor.cell(0, n), flap.cell(1, n));
+    let (x, y) = (exchange(&a, &b, settings(16, 12)).unwrap(), exchange(&b, &a, settings(16, 12)).unwrap());
+    println!(
+        "F = {f} (contour {reference}): {:.1e} in {:.1} s; vertex cells reciprocity {:.1e}",
+        rel(f, reference),
+        start.elapsed().as_secs_f64(),
+        rel(y, x)
+    );
+    assert!(rel(f, reference) < 1e-9, "{f} vs {reference}");
+    assert!(rel(y, x) < 1e-11, "{x:e} vs {y:e}");
 }
