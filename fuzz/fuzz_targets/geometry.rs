@@ -7,22 +7,31 @@
 //! boundaries), `form_factor_between`, `self_form_factor`, `surface_form_factor`, with and
 //! without an occluder, in f32 or f64.
 //!
-//! Asserted: no panic (libFuzzer reports it), and every `Ok` is finite and ≥ 0. Values > 1 are
-//! not asserted against: the fixed rules at the small orders used here (≤ 6, to keep one input
-//! cheap) can exceed 1 for a large face very close to a small one, and invalid-but-accepted
-//! geometry (interpenetrating patches) has no meaningful bound. See pdm-host/FUZZING.md.
+//! The tolerance mode (`adaptive_exchange`, max order 6, max depth 2 so one input stays cheap)
+//! and `pair_exchange` both ways round are called too.
+//!
+//! Asserted: no panic (libFuzzer reports it); every `Ok` is finite and ≥ 0; every `Ok` obeys
+//! the physical bounds the kernel checks since bounds.rs: a form factor F ≤ 1 + rounding, an
+//! exchange A_a·F_ab ≤ min(A_a, A_b) + rounding, with the areas measured at order 16 (or at the
+//! order the kernel used, whichever is larger: a low-order area of a curved patch may be
+//! short); the adaptive estimate finite and ≥ 0. See pdm-host/FUZZING.md.
 #![no_main]
 
 use arbitrary::Arbitrary;
 use libfuzzer_sys::fuzz_target;
 use pdm_kernel::{
-    classify, classify_near, form_factor_between, pair_exchange, self_form_factor, surface_form_factor,
+    adaptive_exchange, classify, classify_near, form_factor_between, pair_exchange, self_form_factor, surface_form_factor,
     touching_exchange, vec3, Adjacency, AnyOccluder, BezierPatch, Cone, Cylinder, Disk, Frame, PairSettings,
-    Parallelogram, ParamRect, Patch, PatchGrid, PdmError, Quadrature, Real, Side, Sphere, SquareMap, Surface, Vec3,
+    Adaptive, Parallelogram, ParamRect, Patch, PatchGrid, PdmError, Quadrature, Real, Side, Sphere, SquareMap, Surface, Vec3,
 };
 
 /// Sample capacity: (order + 1)² for order ≤ 6 (the self integral uses order + 1).
 const CAP: usize = 49;
+
+/// The tolerance mode's settings here: max order 6 (its separate pairs start at ≥ 6 and
+/// compare with order + 2, so it needs (6 + 2)² samples), depth ≤ 2 (≤ 4 leaf pairs).
+const ADAPTIVE_MAX_ORDER: usize = 6;
+const ADAPTIVE_CAP: usize = (ADAPTIVE_MAX_ORDER + 2) * (ADAPTIVE_MAX_ORDER + 2);
 
 /// A number: raw bits (anything, NaN and ∞ included), a small integer, or m·2^e.
 #[derive(Arbitrary, Debug, Clone, Copy)]
@@ -155,6 +164,8 @@ struct Input {
     occluder: Option<OccluderSpec>,
     /// An arbitrary adjacency handed to `touching_exchange` (corner maps from corner indices).
     forced: Option<(bool, bool, Num)>,
+    /// The tolerance mode: `None` skips it; a tolerance 10^−(1 + k % 10), or a raw number.
+    adaptive: Option<(u8, Option<Num>, u8)>,
 }
 
 /// Any of the built-ins, as one type so that a patch and its neighbour share it.
@@ -281,6 +292,49 @@ fn check<T: Real>(what: &str, r: Result<T, PdmError>) -> Option<T> {
     }
 }
 
+/// Relative rounding band above a physical bound: the kernel clamps within 1024 ε; 4096 ε here
+/// (9e-13 in f64, 4.9e-4 in f32).
+fn band<T: Real>() -> T {
+    T::from_f64(4096.0) * T::EPSILON
+}
+
+/// A patch's area for the bound checks: the larger of order 16 and the order the kernel used
+/// (`None` if neither is a usable positive number).
+fn area_for_bounds<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>, order: usize) -> Option<T> {
+    let a = p.area(16).ok().filter(|a| a.is_finite() && *a > T::ZERO);
+    let b = p.area(order.max(2)).ok().filter(|a| a.is_finite() && *a > T::ZERO);
+    match (a, b) {
+        (Some(a), Some(b)) => Some(a.max(b)),
+        (x, y) => x.or(y),
+    }
+}
+
+/// Every `Ok` exchange must be finite, ≥ 0 and ≤ min(A_a, A_b) (+ rounding).
+fn check_exchange<T: Real, SA: Surface<T> + ?Sized, SB: Surface<T> + ?Sized>(
+    what: &str,
+    r: Result<T, PdmError>,
+    a: &Patch<'_, T, SA>,
+    b: &Patch<'_, T, SB>,
+    order: usize,
+) -> Option<T> {
+    let v = check(what, r)?;
+    if let (Some(area_a), Some(area_b)) = (area_for_bounds(a, order), area_for_bounds(b, order)) {
+        let bound = area_a.min(area_b);
+        assert!(
+            v <= bound * (T::ONE + band::<T>()),
+            "{what}: A_a·F_ab = {v} > min(A_a, A_b) = {bound} (A_a {area_a}, A_b {area_b})"
+        );
+    }
+    Some(v)
+}
+
+/// Every `Ok` form factor must be finite and in [0, 1 + rounding].
+fn check_factor<T: Real>(what: &str, r: Result<T, PdmError>) -> Option<T> {
+    let v = check(what, r)?;
+    assert!(v <= T::ONE + band::<T>(), "{what}: F = {v} > 1");
+    Some(v)
+}
+
 fn occluder<T: Real>(spec: OccluderSpec) -> Option<AnyOccluder<T>> {
     match spec {
         OccluderSpec::Sphere(c, r) => Sphere::outer(c.get(), r.get()).ok().map(AnyOccluder::Sphere),
@@ -360,9 +414,24 @@ fn run<T: Real>(input: &Input) {
     assert!(gap.is_finite() && gap >= T::ZERO, "classify_near gap {gap}");
 
     let settings = PairSettings { order: oa, singular_order: os, boundaries: input.boundaries };
-    check("pair_exchange", pair_exchange::<T, _, _, _, CAP>(&a, &b, settings, &occ));
-    check("pair_exchange (no occluder)", pair_exchange::<T, _, _, _, CAP>(&a, &b, settings, &()));
-    check("touching_exchange", touching_exchange(&a, &b, near, gap, os, &occ));
+    let bo = oa.max(os);
+    check_exchange("pair_exchange", pair_exchange::<T, _, _, _, CAP>(&a, &b, settings, &occ), &a, &b, bo);
+    check_exchange("pair_exchange (b, a)", pair_exchange::<T, _, _, _, CAP>(&b, &a, settings, &occ), &b, &a, bo);
+    check_exchange("pair_exchange (no occluder)", pair_exchange::<T, _, _, _, CAP>(&a, &b, settings, &()), &a, &b, bo);
+    check_exchange("touching_exchange", touching_exchange(&a, &b, near, gap, os, &occ), &a, &b, os);
+    if let Some((k, raw, depth)) = input.adaptive {
+        let tolerance = match raw {
+            Some(x) => x.get::<T>(),
+            None => T::from_f64(10f64.powi(-1 - i32::from(k % 10))),
+        };
+        let settings = Adaptive { tolerance, max_order: ADAPTIVE_MAX_ORDER, max_depth: u32::from(depth % 3) };
+        let r = adaptive_exchange::<T, _, _, _, ADAPTIVE_CAP>(&a, &b, settings, &occ);
+        if let Ok(e) = r {
+            assert!(e.error.is_finite() && e.error >= T::ZERO, "adaptive_exchange: estimate {}", e.error);
+        }
+        // The tolerance mode goes up to order max(max_order, 8) + 2 on touching pairs.
+        check_exchange("adaptive_exchange", r.map(|e| e.value), &a, &b, 10);
+    }
     if let Some((edge, swap, g)) = input.forced {
         // A caller-supplied adjacency that need not match the geometry (only IDENTITY and the
         // maps classify found are constructible outside the kernel), with any gap.
@@ -373,22 +442,22 @@ fn run<T: Real>(input: &Input) {
         let (ma, mb) = if swap { (mb, ma) } else { (ma, mb) };
         let adjacency =
             if edge { Adjacency::SharedEdge { a: ma, b: mb } } else { Adjacency::SharedVertex { a: ma, b: mb } };
-        check("touching_exchange (forced)", touching_exchange(&a, &b, adjacency, g.get(), os, &()));
+        check_exchange("touching_exchange (forced)", touching_exchange(&a, &b, adjacency, g.get(), os, &()), &a, &b, os);
     }
-    check(
+    check_factor(
         "form_factor_between",
         form_factor_between::<T, _, _, _, CAP>(&a, &b, Quadrature { order_a: oa, order_b: ob }, &occ),
     );
-    check("self_form_factor", self_form_factor::<T, _, _, CAP>(&a, oa, &()));
+    check_factor("self_form_factor", self_form_factor::<T, _, _, CAP>(&a, oa, &()));
     let dims = input.grid.map(|k| usize::from(k % 3) + 1);
     if let (Ok(ga), Ok(gb)) = (a.grid(dims[0], dims[1]), b.grid(dims[2], dims[3])) {
-        check(
+        check_factor(
             "surface_form_factor",
             surface_form_factor::<T, _, _, _, CAP>(ga, gb, Quadrature { order_a: oa, order_b: ob }, &occ),
         );
     }
     if let Ok(g) = PatchGrid::new(&first, dims[0], dims[1]) {
-        check(
+        check_factor(
             "surface_form_factor (self)",
             surface_form_factor::<T, _, _, _, CAP>(g.clone(), g, Quadrature::uniform(oa), &()),
         );

@@ -6,7 +6,11 @@
 //! `pair_exchange(b, a)` are computed: they go through different local maps); f32 agrees with
 //! f64; planar pairs agree with the independent contour-integral reference
 //! (`pdm_host::reference::contour`), curved pairs with closed forms. Adjacency detection
-//! (`classify`, `classify_near`) and `touching_exchange` are exercised directly.
+//! (`classify`, `classify_near`) and `touching_exchange` are exercised directly. Every value an
+//! entry point returns is checked against the physical bounds 0 ≤ A_a·F_ab ≤ min(A_a, A_b)
+//! (`assert_bounds`); the tolerance mode (`adaptive_exchange`) on touching, nearly touching and
+//! separate flat pairs, both argument orders: bounds, and its estimate ≥ the actual error
+//! against the contour reference unless it did not converge (issue 11 item 6).
 //!
 //! Deterministic: proptest with a fixed ChaCha seed and no failure persistence. Case count per
 //! property: `PDM_FUZZ_CASES` (default: each property's CI count, below; the file runs in
@@ -43,8 +47,9 @@ use std::f64::consts::{LOG10_2, PI};
 
 use pdm_host::reference::{closed_form, contour};
 use pdm_kernel::{
-    classify, classify_near, pair_exchange, touching_exchange, vec3, Adjacency, Cylinder, Disk, Flipped, Frame,
-    PairSettings, Parallelogram, ParamRect, Patch, PatchGrid, PdmError, Real, Side, Sphere, Surface, Vec3,
+    adaptive_exchange, classify, classify_near, pair_exchange, touching_exchange, vec3, Adaptive, Adjacency, Cylinder,
+    Disk, Flipped, Frame, PairSettings, Parallelogram, ParamRect, Patch, PatchGrid, PdmError, Real, Side, Sphere,
+    Surface, Vec3,
 };
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, RngSeed, TestCaseError, TestError, TestRunner};
@@ -135,6 +140,12 @@ fn run_property<S: Strategy>(
         Err(TestError::Fail(reason, case)) => panic!("{name}: {reason}\nminimal failing case: {case:#?}"),
         Err(TestError::Abort(reason)) => panic!("{name}: aborted: {reason}"),
     }
+}
+
+/// Counts an event in the stats (printed as its "maximum").
+fn count(stats: &mut Stats, name: &'static str) {
+    let n = stats.max.iter().find(|(n, _, _)| *n == name).map_or(1.0, |(_, m, _)| m + 1.0);
+    stats.see(name, n);
 }
 
 fn rel(got: f64, reference: f64) -> f64 {
@@ -292,8 +303,38 @@ fn settings(order: usize, singular_order: usize) -> PairSettings {
     PairSettings { order, singular_order, boundaries: false }
 }
 
+/// The physical bounds on an exchange A_a·F_ab between patches of areas `area_a`, `area_b`:
+/// finite, 0 ≤ A_a·F_ab ≤ min(A_a, A_b) (so both F_ab and F_ba in [0, 1]), up to `tol`
+/// relative. Panics with the numbers otherwise (proptest catches it as a failure and shrinks).
+fn assert_bounds(what: &str, x: f64, area_a: f64, area_b: f64, tol: f64) {
+    let bound = area_a.min(area_b);
+    assert!(
+        x.is_finite() && x >= 0.0 && x <= bound * (1.0 + tol),
+        "{what}: A_a·F_ab = {x:e} outside [0, min(A_a, A_b) = {bound:e}] (F_ab = {:e}, F_ba = {:e})",
+        x / area_a,
+        x / area_b
+    );
+}
+
+/// Relative allowance above the bound: rounding (f32: its geometry is rounded too).
+fn bound_tol<T: Real>() -> f64 {
+    if T::MANTISSA_DIGITS > 24 {
+        1e-9
+    } else {
+        1e-4
+    }
+}
+
+/// Area of a patch in f64 (exact for parallelograms at any order; curved at order 16).
+fn area_of<T: Real, S: Surface<T>>(p: &Patch<'_, T, S>) -> f64 {
+    p.area(16).unwrap().to_f64()
+}
+
+/// `pair_exchange` at capacity 1024; every `Ok` is checked against the physical bounds.
 fn exchange<T: Real>(a: &Patch<'_, T, Quad<T>>, b: &Patch<'_, T, Quad<T>>, s: PairSettings) -> Result<f64, PdmError> {
-    pair_exchange::<T, _, _, _, 1024>(a, b, s, &()).map(Real::to_f64)
+    let x = pair_exchange::<T, _, _, _, 1024>(a, b, s, &())?.to_f64();
+    assert_bounds("pair_exchange", x, area_of(a), area_of(b), bound_tol::<T>());
+    Ok(x)
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -441,6 +482,7 @@ fn check_edge_case(case: &EdgeCase, stats: &mut Stats) -> Result<(), TestCaseErr
     let singular_order = 16;
     // (Reciprocity and the direct call hold at any order: checked at 12, cheaper.)
     let direct = touching_exchange(&a0, &b0, near, gap, 12, &()).map_err(|e| TestCaseError::fail(format!("{e:?}")))?;
+    assert_bounds("touching_exchange", direct, area_of(&a0), area_of(&b0), 1e-9);
     let paired = exchange(&a0, &b0, settings(16, 12)).map_err(|e| TestCaseError::fail(format!("{e:?}")))?;
     prop_assert_eq!(direct, paired);
 
@@ -504,8 +546,16 @@ fn check_edge_case_f32(case: &EdgeCase, stats: &mut Stats) -> Result<(), TestCas
         let x64 =
             exchange(&floor64.cell(0, n), &flap64.cell(k, n), s).map_err(|e| TestCaseError::fail(format!("{e:?}")))?;
         let (a, b) = (floor32.cell(0, n), flap32.cell(k, n));
-        let x32 = exchange(&a, &b, s).map_err(|e| TestCaseError::fail(format!("f32: {e:?}")))?;
-        let y32 = exchange(&b, &a, s).map_err(|e| TestCaseError::fail(format!("f32: {e:?}")))?;
+        // A contact whose geometry f32 does not resolve to ≈ 1e-4 (rounding band against the
+        // shortest edge × the fold angle, finding 6 and seed 20260601) is refused both ways.
+        let (x32, y32) = match (exchange(&a, &b, s), exchange(&b, &a, s)) {
+            (Ok(x), Ok(y)) => (x, y),
+            (Err(PdmError::Degenerate), Err(PdmError::Degenerate)) if classify_near(&a, &b).1 == f32::MAX => {
+                count(stats, "f32 refused as unresolvable (count)");
+                continue;
+            }
+            (x, y) => return Err(TestCaseError::fail(format!("f32: {x:?} / {y:?}"))),
+        };
         // Relative 1e-4, or 1e-7 of the emitter's area (F ≈ 1e-5 near 180°).
         let area = a.area(2).map_err(|e| TestCaseError::fail(format!("{e:?}")))?.to_f64();
         let r = (x32 - x64).abs() / (x64.abs() + 1e-3 * area);
@@ -614,6 +664,7 @@ fn check_vertex_case(case: &VertexCase, stats: &mut Stats) -> Result<(), TestCas
     }
     let s = settings(16, 20);
     let direct = touching_exchange(&a, &b, near, gap, 20, &()).map_err(fail)?;
+    assert_bounds("touching_exchange", direct, area_of(&a), area_of(&b), 1e-9);
     let ab = exchange(&a, &b, s).map_err(fail)?;
     prop_assert_eq!(direct, ab);
     let ba = exchange(&b, &a, s).map_err(fail)?;
@@ -684,14 +735,7 @@ fn check_invariants<T: Real>(case: &EdgeCase, stats: &mut Stats) -> Result<(), T
         (Err(PdmError::Degenerate), Err(PdmError::Degenerate))
             if !wide && !matches!(classify_near(&a, &b).0, Adjacency::Separate) =>
         {
-            stats.see(
-                "f32 refused as unresolvable (count)",
-                stats
-                    .max
-                    .iter()
-                    .find(|(n, _, _)| *n == "f32 refused as unresolvable (count)")
-                    .map_or(1.0, |(_, m, _)| m + 1.0),
-            );
+            count(stats, "f32 refused as unresolvable (count)");
             return Ok(());
         }
         (x, y) => return Err(TestCaseError::fail(format!("{x:?} / {y:?}"))),
@@ -803,11 +847,15 @@ fn grid_exchange<T: Real, SA: Surface<T>, SB: Surface<T>>(
     for pa in a {
         for pb in b.clone() {
             let x = pair_exchange::<T, _, _, _, 1024>(&pa, &pb, s, &())?.to_f64();
+            let (area_a, area_b) = (area_of(&pa), area_of(&pb));
+            assert_bounds("pair_exchange (curved cells)", x, area_a, area_b, bound_tol::<T>());
             ab += x;
             ba += if matches!(classify_near(&pa, &pb).0, Adjacency::Separate) {
                 x
             } else {
-                pair_exchange::<T, _, _, _, 1024>(&pb, &pa, s, &())?.to_f64()
+                let y = pair_exchange::<T, _, _, _, 1024>(&pb, &pa, s, &())?.to_f64();
+                assert_bounds("pair_exchange (curved cells, b → a)", y, area_b, area_a, bound_tol::<T>());
+                y
             };
         }
     }
@@ -890,6 +938,116 @@ fn check_curved(case: &CurvedCase, stats: &mut Stats) -> Result<(), TestCaseErro
 #[test]
 fn curved_touching_pairs_against_closed_forms() {
     run_property("curved: disk/wall, base/dome", 4, curved_strategy(), |case, stats| check_curved(&case, stats));
+}
+
+// ---------------------------------------------------------------------------------------------
+// The tolerance mode on flat pairs: touching, nearly touching and separate.
+
+/// Floor and flap as in the edge property (w = 1, l/w ∈ [¼, 4], h/w ∈ [½, 2], θ ∈ [1°, 179°]),
+/// the flap touching (gap 0), nearly touching (1e-12 … 1e-3 of the shortest side) or separate
+/// (5e-2 … 2), with a tolerance 1e-8 … 1e-3.
+fn adaptive_strategy() -> impl Strategy<Value = (EdgeCase, f64)> {
+    let gap = prop_oneof![
+        1 => Just(0.0),
+        1 => (-12.0..=-3.0f64).prop_map(|e| 10f64.powf(e)),
+        1 => (-1.3..=0.3f64).prop_map(|e| 10f64.powf(e)),
+    ];
+    (
+        1.0..=179.0f64,
+        (-2.0 * LOG10_2..=2.0 * LOG10_2, -LOG10_2..=LOG10_2),
+        gap,
+        motion_strategy(),
+        0..8u8,
+        0..8u8,
+        -8.0..=-3.0f64,
+    )
+        .prop_map(|(theta_deg, (l, h), gap, motion, variant_floor, variant_flap, tol)| {
+            let case = EdgeCase {
+                theta_deg,
+                l: 10f64.powf(l),
+                w: 1.0,
+                h: 10f64.powf(h),
+                gap,
+                motion,
+                variant_floor,
+                variant_flap,
+            };
+            (case, 10f64.powf(tol))
+        })
+}
+
+fn check_adaptive(case: &EdgeCase, tolerance: f64, stats: &mut Stats) -> Result<(), TestCaseError> {
+    let (floor, flap) = case.build::<f64>().map_err(|e| TestCaseError::fail(format!("build: {e:?}")))?;
+    let (a, b) = (floor.cell(0, 1), flap.cell(0, 1));
+    // Small limits keep one case cheap (≤ 2⁴ leaf pairs, touching orders ≤ 12).
+    let settings = Adaptive { tolerance, max_order: 12, max_depth: 4 };
+    let kind = match classify_near(&a, &b).0 {
+        Adjacency::Separate => "separate",
+        Adjacency::SharedEdge { .. } if case.gap == 0.0 => "edge",
+        _ => "near",
+    };
+    let (ab, ba) = match (
+        adaptive_exchange::<f64, _, _, _, 256>(&a, &b, settings, &()),
+        adaptive_exchange::<f64, _, _, _, 256>(&b, &a, settings, &()),
+    ) {
+        (Ok(ab), Ok(ba)) => (ab, ba),
+        // Open (adaptive.rs, not this work): a separate pair folded to a few degrees, the flap
+        // lifted by ≈ 9 % of its size, is refused by the bounds check (the plain rule on a
+        // nearly coincident pair exceeds min(A_a, A_b)): an error, not a wrong value. Counted;
+        // `adaptive_nearly_folded_separate_pair_is_refused` (ignored) reproduces it.
+        (Err(PdmError::InvalidResult), _) | (_, Err(PdmError::InvalidResult)) if kind == "separate" => {
+            count(stats, "separate refused, InvalidResult (count)");
+            return Ok(());
+        }
+        (x, y) => return Err(TestCaseError::fail(format!("adaptive_exchange ({kind}): {x:?} / {y:?}"))),
+    };
+    let m = case.motion();
+    let (area_a, area_b) = (case.l * case.w * m.scale * m.scale, case.l * case.h * m.scale * m.scale);
+    assert_bounds("adaptive_exchange", ab.value, area_a, area_b, 1e-9);
+    assert_bounds("adaptive_exchange (b, a)", ba.value, area_b, area_a, 1e-9);
+    let (pf, pp) = case.polygons();
+    let reference = contour::polygon_form_factor(&pf, &pp) * area_a;
+    for (what, e) in [("a, b", ab), ("b, a", ba)] {
+        let actual = (e.value - reference).abs();
+        // The contour reference is good to ≈ 1e-14 relative; below that nothing is measured.
+        let floor = 1e-13 * reference.abs();
+        prop_assert!(e.error >= 0.0 && e.error.is_finite(), "{what}: estimate {:e}", e.error);
+        // TODO(converged): once `Estimate` has its `converged: bool` (another branch), replace
+        // the proxy by the flag: a converged estimate must bound the actual error; an
+        // unconverged one may not, but must say so. Until then the proxy is the kernel's own
+        // stopping rule (error ≤ tolerance × |value|; anything else is the depth limit).
+        let converged = e.error <= tolerance * e.value.abs();
+        let ratio = actual / (e.error + floor);
+        stats.see(
+            if kind == "separate" {
+                "actual / estimate (separate)"
+            } else if kind == "edge" {
+                "actual / estimate (edge)"
+            } else {
+                "actual / estimate (near)"
+            },
+            ratio,
+        );
+        stats.see("actual / (tolerance × value)", actual / (tolerance * reference.abs()));
+        if !converged {
+            count(stats, "not converged (count)");
+        }
+        prop_assert!(
+            actual <= e.error + floor || !converged,
+            "{what} ({kind}): value {:.15e}, contour {reference:.15e}: actual error {actual:.2e} > estimate {:.2e} (tolerance {tolerance:.1e}, {} evaluations)",
+            e.value,
+            e.error,
+            e.evaluations
+        );
+    }
+    Ok(())
+}
+
+#[test]
+fn adaptive_exchange_estimates_bound_the_error_on_flat_pairs() {
+    run_property("adaptive, flat pairs", 24, adaptive_strategy(), |(case, tol), stats| {
+        check_adaptive(&case, tol, stats)
+    });
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1138,4 +1296,189 @@ fn error_versus_order() {
         }
         println!("{line}");
     }
+}
+
+/// Finding 11 (seed 20260601, case 1423 of the any-aspect invariants): an f32 floor
+/// 0.013 × 0.12 under a 7.2-high flap at 163°, coordinates ≈ 3300 shortest edges from the origin
+/// (rounding band / shortest edge = 6.6e-3 < 1/32 accepted it): `Ok` 2.6e-4 off f64, and
+/// 2.7e-4 from its reciprocal. Fixed: the resolution threshold is 1/1024 (expected error of an
+/// accepted f32 contact ≤ ≈ 7e-5): refused as `Err(Degenerate)` both ways.
+#[test]
+fn seed_20260601_f32_thin_floor_under_a_tall_flap_far_from_the_origin() {
+    let case = EdgeCase {
+        theta_deg: 162.9658769985393,
+        l: 0.013023025768173564,
+        w: 0.12281047187791093,
+        h: 7.241572885029718,
+        gap: 0.0,
+        motion: (
+            -0.9370169743854797,
+            0.3659170038161484,
+            2.6713817862997886,
+            6.249821310313004,
+            [0.0, -5.926657689742695, 0.0],
+        ),
+        variant_floor: 2,
+        variant_flap: 1,
+    };
+    let (a64, b64) = case.build::<f64>().unwrap();
+    let (a32, b32) = case.build::<f32>().unwrap();
+    let (a64, b64, a32, b32) = (a64.cell(0, 1), b64.cell(0, 1), a32.cell(0, 1), b32.cell(0, 1));
+    let s = settings(8, 12);
+    let x64 = exchange(&a64, &b64, s).unwrap();
+    let (x32, y32) = (exchange(&a32, &b32, s), exchange(&b32, &a32, s));
+    println!("f64 {x64:e}; f32 {x32:?} / {y32:?}; classify_near {:?}", classify_near(&a32, &b32));
+    match (x32, y32) {
+        (Err(PdmError::Degenerate), Err(PdmError::Degenerate)) => {}
+        (Ok(x), Ok(y)) => {
+            assert!(rel(x, x64) < 1e-4 && rel(y, x64) < 1e-4 && rel(y, x) < 1e-4, "{x:e} / {y:e} vs {x64:e}")
+        }
+        (x, y) => panic!("{x:?} / {y:?}"),
+    }
+    // The same pair nearer the origin (coordinates ≈ 1 size: band / shortest edge ≈ 1e-4) is
+    // computed, and to f32 accuracy.
+    let near =
+        EdgeCase { motion: (-0.9370169743854797, 0.3659170038161484, 2.6713817862997886, 0.0, [0.0; 3]), ..case };
+    let (a64, b64) = near.build::<f64>().unwrap();
+    let (a32, b32) = near.build::<f32>().unwrap();
+    let (a64, b64, a32, b32) = (a64.cell(0, 1), b64.cell(0, 1), a32.cell(0, 1), b32.cell(0, 1));
+    let x64 = exchange(&a64, &b64, s).unwrap();
+    let (x, y) = (exchange(&a32, &b32, s).unwrap(), exchange(&b32, &a32, s).unwrap());
+    println!("near the origin: f64 {x64:e}; f32 {x:e} / {y:e}");
+    assert!(rel(x, x64) < 1e-4 && rel(y, x64) < 1e-4, "{x:e} / {y:e} vs {x64:e}");
+}
+
+/// Finding 12 (seed 20260601, edge property): unit squares folded to 1° with the flap lifted by
+/// 1e-3 along its plane were 1.5e-6 / 1.0e-7 / 4.5e-8 / 2.3e-9 / 1.9e-9 off at orders
+/// 8 / 12 / 16 / 20 / 24 (the error ∝ gap: 4.5e-7 at 1e-2, 4.5e-9 at 1e-4, order 16). The
+/// shell ζ ∈ [0, g] below the gap was not graded: the peak line of the folded pair reaches
+/// ρ₂ = 0 at ζ = g from below, where the patches are only ≈ θ·g apart. Fixed: ζ is graded
+/// towards g there too: 2.8e-7 / 1.8e-10 / 1.7e-13 / 6.8e-16 / 3.4e-16.
+#[test]
+fn seed_20260601_unit_squares_folded_to_1_degree_with_a_gap() {
+    for gap in [1e-2, 1e-3, 1e-4] {
+        let (adjacency, f, reference) = single_patch(&plain_case(1.0, 1.0, 1.0, 1.0, gap), 16);
+        println!("gap {gap:e}: {adjacency:?} F = {f} (contour {reference}): {:.1e}", rel(f, reference));
+        assert!(matches!(adjacency, Adjacency::SharedEdge { .. }), "{adjacency:?}");
+        assert!(rel(f, reference) < 1e-11, "gap {gap:e}: F = {f} vs {reference}");
+    }
+}
+
+/// Open (adaptive.rs, outside this work), found by `adaptive_exchange_estimates_bound_the_error_on_flat_pairs`:
+/// unit squares folded to 1°, the flap lifted by 0.0875 along its plane (a separate pair, nearly
+/// coincident near the edge), tolerance 1e-3: `adaptive_exchange` returns `Err(InvalidResult)`
+/// (the bounds check refusing the plain rule's value). Asserts the correct behaviour.
+#[test]
+#[ignore = "open: adaptive.rs refuses a nearly folded separate pair"]
+fn adaptive_nearly_folded_separate_pair_is_refused() {
+    let case = plain_case(1.0, 1.0, 1.0, 1.0, 0.08749701870019223);
+    let (floor, flap) = case.build::<f64>().unwrap();
+    let (a, b) = (floor.cell(0, 1), flap.cell(0, 1));
+    let (pf, pp) = case.polygons();
+    let reference = contour::polygon_form_factor(&pf, &pp);
+    println!("classify_near {:?}, contour F = {reference}", classify_near(&a, &b));
+    println!("pair_exchange (16, 12): {:?}", pair_exchange::<f64, _, _, _, 1024>(&a, &b, settings(16, 12), &()));
+    let e =
+        adaptive_exchange::<f64, _, _, _, 256>(&a, &b, Adaptive { tolerance: 1e-3, max_order: 12, max_depth: 4 }, &());
+    println!("adaptive_exchange (1e-3, 12, 4): {e:?}");
+    let e = e.unwrap();
+    assert!((e.value - reference).abs() <= e.error, "{e:?} vs {reference}");
+}
+
+/// Open (adaptive.rs's estimate for touching pairs, the difference of orders 6 and 8), found by
+/// the adaptive property's long run (seed 20260601, case 90, shrunk): floor 0.761 × 1 and flap
+/// 0.761 × 0.935 sharing an edge at 28.6°, tolerance 1e-3: value 0.44385973468 against the
+/// contour 0.44385973829, actual error 3.6e-9 > estimate 1.1e-9 (32352 evaluations: orders 6
+/// and 8). Prints the touching transform's error per order; asserts the correct behaviour.
+#[test]
+#[ignore = "open: the tolerance mode's estimate on a touching pair is below the actual error"]
+fn adaptive_touching_pair_estimate_below_the_actual_error() {
+    let case = plain_case(28.569596826911052, 0.760867382867785, 1.0, 0.9350669727448926, 0.0);
+    let (floor, flap) = case.build::<f64>().unwrap();
+    let (a, b) = (floor.cell(0, 1), flap.cell(0, 1));
+    let (pf, pp) = case.polygons();
+    let reference = contour::polygon_form_factor(&pf, &pp) * case.l * case.w;
+    let (near, gap) = classify_near(&a, &b);
+    for order in [4, 6, 8, 10, 12, 16, 20] {
+        let x = touching_exchange(&a, &b, near, gap, order, &()).unwrap();
+        println!("order {order}: {x:.16e}, error {:+.2e}", x - reference);
+    }
+    let e =
+        adaptive_exchange::<f64, _, _, _, 256>(&a, &b, Adaptive { tolerance: 1e-3, max_order: 12, max_depth: 4 }, &())
+            .unwrap();
+    let actual = (e.value - reference).abs();
+    println!("adaptive: {e:?}, actual error {actual:.2e}");
+    assert!(actual <= e.error, "actual {actual:e} > estimate {:e}", e.error);
+}
+
+/// From `cargo fuzz` (issue 11 run, a 30 s timeout): a whole outer sphere of radius 2.5e-29
+/// centred at (−85, −1.8e-4, 4.3e-39) — smaller than the rounding of its coordinates — and a
+/// parallelogram on its two poles (corners 0 and 3) with the other side (−105, −105, −105),
+/// reversed; orders 7. `touching_exchange` on the vertex contact spent the time in
+/// `vertex_sum`'s nested gradings (widths at their 1e-12 floor: rounding noise). Fixed: a
+/// contact is resolved only if each patch as a whole is (`Err(Degenerate)` here).
+#[test]
+fn fuzz_sphere_below_the_rounding_of_its_coordinates() {
+    let center = vec3(-85.0, -6169.0 * 2f64.powi(-25), f64::from(f32::from_bits(3_101_780)));
+    let sphere = Sphere::outer(center, f64::from(f32::from_bits(268_457_044))).unwrap();
+    let a = Patch::whole(&sphere).unwrap();
+    let r = a.rect();
+    let (p, q) = (sphere.point(r.t0, r.s0), sphere.point(r.t1, r.s1));
+    let quad = Parallelogram::new(p, q - p, vec3(-105.0, -105.0, -105.0)).unwrap().reversed();
+    let b = Patch::whole(&quad).unwrap();
+    let (near, gap) = classify_near(&a, &b);
+    println!("classify_near {near:?}, gap {gap:e}");
+    let start = std::time::Instant::now();
+    let x = touching_exchange(&a, &b, near, gap, 7, &());
+    let y = pair_exchange::<f64, _, _, _, 64>(&a, &b, settings(7, 7), &());
+    let z = pair_exchange::<f64, _, _, _, 64>(&b, &a, settings(7, 7), &());
+    let t = start.elapsed().as_secs_f64();
+    println!("{x:?} / {y:?} / {z:?} in {t:.2} s");
+    for v in [x, y, z] {
+        assert!(v.map_or(true, |v| v.is_finite() && v >= 0.0), "{v:?}");
+    }
+    assert!(t < 1.0, "{t} s");
+}
+
+/// Finding 16 (edge property, seed 20261201, case 34): 1545 unit cells along an edge folded to
+/// 1° with a gap of 1e-3, far from the origin: 1.27e-7 off the contour (1e-9 allowed); the
+/// property saw 4.5e-10 reciprocity between neighbouring cells. Suspected: the vertex transform does not grade
+/// ζ towards the gap (finding 12 in the edge transform) — ruled out: a trial grading there left
+/// F unchanged to all digits, and the vertex cells are 6.4e-13 from reciprocal. Open.
+#[test]
+#[ignore = "open: finding 16, cause not found"]
+fn seed_20261201_cells_along_an_edge_folded_to_1_degree_with_a_gap() {
+    let case = EdgeCase {
+        theta_deg: 1.0,
+        l: 1545.1283354437887,
+        w: 1.0,
+        h: 1.0,
+        gap: 0.001,
+        motion: (
+            0.07435193319503826,
+            0.47360582701575427,
+            1.377270038731309,
+            6.030323589296109,
+            [-2.3295145103358683, -9.909084458994052, -8.056785610297707],
+        ),
+        variant_floor: 2,
+        variant_flap: 7,
+    };
+    let (floor, flap) = case.build::<f64>().unwrap();
+    let n = case.cells();
+    let m = case.motion();
+    let start = std::time::Instant::now();
+    let f = edge_sum(&floor, &flap, n, 16).unwrap() / (case.l * case.w * m.scale * m.scale);
+    let (pf, pp) = case.polygons();
+    let reference = contour::polygon_form_factor(&pf, &pp);
+    let (a, b) = (floor.cell(0, n), flap.cell(1, n));
+    let (x, y) = (exchange(&a, &b, settings(16, 12)).unwrap(), exchange(&b, &a, settings(16, 12)).unwrap());
+    println!(
+        "F = {f} (contour {reference}): {:.1e} in {:.1} s; vertex cells reciprocity {:.1e}",
+        rel(f, reference),
+        start.elapsed().as_secs_f64(),
+        rel(y, x)
+    );
+    assert!(rel(f, reference) < 1e-9, "{f} vs {reference}");
+    assert!(rel(y, x) < 1e-11, "{x:e} vs {y:e}");
 }

@@ -249,11 +249,17 @@ fn shortest_edge<T: Real>(c: &[Vec3<T>; 4], collapsed: T) -> T {
 /// Fraction of the shortest edge (times the fold parameter, for a nearly folded edge pair) that
 /// the rounding band of the coordinates (16 ε × their magnitude) may reach before a contact is
 /// refused as unresolvable (see [`classify_near`]). A pair folded to θ moves by ≈ θ × its size
-/// when θ changes by 100 %, so rounding must be small against θ × size, not just the size. At
-/// 1/4 (the first choice), f32 pairs at 1–1.5° with coordinates 600–800 times their shortest
-/// edge still returned F = 1.003 (seed 7 of the invariants property); at 1/32 they are refused
-/// and the f32 properties near the origin (coordinates ≤ ≈ 100 shortest edges) are not affected.
-const RESOLUTION: f64 = 1.0 / 32.0;
+/// when θ changes by 100 %, so rounding must be small against θ × size, not just the size.
+///
+/// Measured (f32 against f64, touching flat pairs, 1°…163°, aspect up to 1 : 556, coordinates
+/// 1…100 sizes from the origin): the relative error is ≈ 0.01…0.075 × q, q = band / (shortest
+/// edge × min(1, fold)), at every angle and aspect — the rounding of the corners moves the
+/// shared edge by ε × magnitude. At 1/32 (608e327) that allowed ≈ 2e-3: seed 20260601 found a
+/// 0.013 × 0.12 floor under a 7.2-high flap at 163°, coordinates ≈ 3300 shortest edges
+/// (q = 6.6e-3), 2.6e-4 off f64 and 2.7e-4 from reciprocal as `Ok`. At 1/1024 the error of an
+/// accepted f32 pair is ≤ ≈ 7e-5 (< 1e-4); f32 pairs at 90° are accepted up to coordinates ≈ 500
+/// shortest edges, at 1° up to ≈ 9 (f64: 4e12 and 7e10).
+const RESOLUTION: f64 = 1.0 / 1024.0;
 
 /// Adjacency at the tight tolerance (`near` = false: [`adjacency_tolerance`] × patch size) or the
 /// near-contact one, and the relative gap of the matched points (`T::MAX`: unresolvable).
@@ -304,8 +310,16 @@ where
     // The geometry is resolved when the rounding band is small against every edge (times the
     // fold parameter for an edge pair); otherwise a contact found is reported with the gap `T::MAX`
     // (refused by touching_exchange).
+    // Each patch as a whole must be resolved too: edges below the tight tolerance are skipped
+    // as collapsed (a pole), so a patch smaller than the rounding of its coordinates (a sphere of
+    // radius 2.5e-29 at x = −85, `cargo fuzz`) would otherwise pass on the other patch's edges
+    // alone and send rounding noise through the graded transforms (a 30 s timeout).
+    let smallest_patch = diameter(&ca).min(diameter(&cb));
     let flag = |adjacency: Adjacency, gap: T, sensitivity: T| {
-        let resolved = shortest < T::MAX && band <= T::from_f64(RESOLUTION) * shortest * sensitivity.min(T::ONE);
+        let resolution = T::from_f64(RESOLUTION);
+        let resolved = shortest < T::MAX
+            && band <= resolution * shortest * sensitivity.min(T::ONE)
+            && band <= resolution * smallest_patch;
         if resolved {
             (adjacency, gap)
         } else {
@@ -449,7 +463,10 @@ fn unit_points<T: Real>(rule: &GaussRule<T>) -> impl Iterator<Item = (T, T)> + '
 /// peak is resolved. A gap of `T::MAX` (contact not resolvable in the working precision, see
 /// [`classify_near`]) is refused with `Err(Degenerate)`.
 /// `Separate` pairs are refused (`Err(Degenerate)`) — use the plain sum for them; `Identical`
-/// pairs too (a patch's own F_ii needs [`crate::self_form_factor`]).
+/// pairs too (a patch's own F_ii needs [`crate::self_form_factor`]). The result is checked
+/// against the physical bounds 0 ≤ A_a·F_{a→b} ≤ min(A_a, A_b) (areas at `order`):
+/// `Err(InvalidResult)` outside them (a caller-supplied adjacency that does not match the
+/// geometry), clamped within rounding.
 ///
 /// Patches of any aspect ratio: the variables are scaled by the physical lengths of the sides
 /// (edge length and the two widths; the four sides at a vertex) so that the cube split into
@@ -517,11 +534,9 @@ where
         }
         Adjacency::Separate | Adjacency::Identical => return Err(PdmError::Degenerate),
     };
-    let value = sum * T::FRAC_1_PI;
-    if !value.is_finite() || value < T::ZERO {
-        return Err(PdmError::InvalidResult);
-    }
-    Ok(value)
+    // 0 ≤ A_a·F_ab ≤ min(A_a, A_b) (`Err(InvalidResult)` otherwise, rounding clamped).
+    let order = order.max(2);
+    crate::bounds::exchange(sum * T::FRAC_1_PI, a.area(order)?, b.area(order)?)
 }
 
 /// Length of the local coordinate line from `p` to `q` (a 4-segment polyline).
@@ -652,7 +667,11 @@ where
             // grade ζ towards e2 too. Likewise at ζ = gap, where the peak line of a gapped
             // pair enters the pyramid.
             let toward_break = if (s0 == e2 || s0 == gap) && grade { fold * s0 / (s1 - s0) } else { T::ZERO };
-            for_each_interval(toward_break, false, |t0, t1| {
+            // Below the gap (the shell [0, g]) the same peak line reaches ρ₂ = 0 at ζ = g from
+            // below, where the two patches are only ≈ θ·g apart: grade ζ towards its upper end.
+            let toward_gap = if s1 == gap && s0 < s1 && grade { fold * s1 / (s1 - s0) } else { T::ZERO };
+            let (grading, toward_one) = if toward_gap > T::ZERO { (toward_gap, true) } else { (toward_break, false) };
+            for_each_interval(grading, toward_one, |t0, t1| {
                 let (z0, z1) = (s0 + (s1 - s0) * t0, s0 + (s1 - s0) * t1);
                 let dz = z1 - z0;
                 for (zu, wz) in unit_points(rule) {
