@@ -77,7 +77,8 @@ where
     T: Real,
     O: Occluder<T> + ?Sized,
 {
-    crate::bounds::form_factor(exchange(a, b, occluders)? / a.area())
+    // `exchange` already bounds A_a·F_{a→b} by min(A_a, A_b), so F ≤ 1 here.
+    Ok(exchange(a, b, occluders)? / a.area())
 }
 
 /// F_{a→b} between two patches, sampling both (buffers of capacity `CAP` on the stack: use
