@@ -22,10 +22,11 @@ fn rounding_band<T: Real>() -> T {
 /// the firmware's flash budget).
 #[inline(never)]
 pub(crate) fn exchange<T: Real>(value: T, area_a: T, area_b: T) -> Result<T, PdmError> {
-    let bound = area_a.min(area_b);
-    // NaN fails both comparisons; a non-finite bound gives no finite upper limit.
+    // Plain comparisons (no fmin: a library call on targets without the instruction). NaN
+    // fails every comparison; a non-finite bound gives no finite upper limit.
+    let bound = if area_a < area_b { area_a } else { area_b };
     if value >= T::ZERO && value <= bound * (T::ONE + rounding_band::<T>()) && bound.is_finite() {
-        Ok(value.min(bound))
+        Ok(if value < bound { value } else { bound })
     } else {
         Err(PdmError::InvalidResult)
     }
