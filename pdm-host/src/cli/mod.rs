@@ -72,7 +72,7 @@ struct ValidateArgs {
     mode: Option<ModeArg>,
     /// Accurate mode with a per-pair relative tolerance: order and subdivision chosen per
     /// patch pair by pdm_kernel::adaptive_exchange (e.g. 1e-8) instead of fixed orders.
-    #[arg(long, value_name = "TOL", value_parser = parse_tolerance, allow_negative_numbers = true)]
+    #[arg(long, value_name = "TOL", value_parser = parse_tolerance, allow_hyphen_values = true)]
     tolerance: Option<f64>,
     /// The paper's discretisations: 86 (sphere 4x8 + 3x3 per face) or 280 (sphere 8x8 + 6x6 per face).
     #[arg(long, value_name = "86|280", value_parser = parse_patches, conflicts_with_all = ["sphere_grid", "face_grid"])]
