@@ -220,6 +220,19 @@ fn bad_input_is_one_line_naming_the_value() {
         (&["--tolerance", "0"], "0"),
         (&["--tolerance", "1e-20"], "1e-20"),
         (&["--tolerance", "nan"], "nan"),
+        (&["--tolerance", "-1e-3"], "-1e-3"),
+        (&["--tolerance", "inf"], "inf"),
+        (&["--tolerance", "0.5"], "0.5"),
+        (&["--order", "33"], "33"),
+        (&["--order", "-1"], "-1"),
+        (&["--singular-order", "0"], "0"),
+        (&["--face-grid", "65"], "65"),
+        (&["--sphere-grid", "257x8"], "257x8"),
+        (&["--repeat", "1001"], "1001"),
+        (&["--threads", "-1"], "-1"),
+        (&["--threads", "5000"], "5000"),
+        // Paper mode keeps every patch's samples: 3.8 GiB here.
+        (&["--sphere-grid", "256x256", "--order", "32"], "256x256"),
         (&["--mode", "paper", "--tolerance", "1e-6"], "tolerance"),
         (&["--bogus"], "--bogus"),
         (&["--patches", "86", "--face-grid", "4"], "--face-grid"),
@@ -238,6 +251,16 @@ fn bad_input_is_one_line_naming_the_value() {
         assert!(lines[0].contains(named), "{all:?}: does not name {named}: {stderr}");
         assert!(out.stdout.is_empty(), "{all:?}: wrote to stdout");
     }
+}
+
+/// The tolerance mode at the largest sample capacity (order 28: CAP = 1024) used to overflow
+/// rayon's 2 MiB worker stacks; the workers now get stacks sized for the capacity
+/// (`pdm_host::validate::stack`). Also in debug builds.
+#[test]
+fn largest_capacity_in_tolerance_mode_does_not_overflow() {
+    let j = validate_json(&["--tolerance", "1e-3", "--order", "28"]);
+    let s2f = numbers(&j["sphere_to_face"], 6);
+    assert!(s2f.iter().all(|f| (f - 1.0 / 6.0).abs() < 1e-3), "{s2f:?}");
 }
 
 #[test]

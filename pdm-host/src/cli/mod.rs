@@ -72,7 +72,7 @@ struct ValidateArgs {
     mode: Option<ModeArg>,
     /// Accurate mode with a per-pair relative tolerance: order and subdivision chosen per
     /// patch pair by pdm_kernel::adaptive_exchange (e.g. 1e-8) instead of fixed orders.
-    #[arg(long, value_name = "TOL", value_parser = parse_tolerance)]
+    #[arg(long, value_name = "TOL", value_parser = parse_tolerance, allow_hyphen_values = true)]
     tolerance: Option<f64>,
     /// The paper's discretisations: 86 (sphere 4x8 + 3x3 per face) or 280 (sphere 8x8 + 6x6 per face).
     #[arg(long, value_name = "86|280", value_parser = parse_patches, conflicts_with_all = ["sphere_grid", "face_grid"])]
@@ -101,7 +101,7 @@ struct ValidateArgs {
     /// Timed repetitions; times are medians [default: 3 in paper mode, 1 in accurate mode].
     #[arg(long, value_name = "N", value_parser = parse_repeat, allow_negative_numbers = true)]
     repeat: Option<usize>,
-    /// Recompute the independent face -> face reference for R = 1 (~15 s) instead of using
+    /// Recompute the independent face -> face reference for R = 1 (~2 s) instead of using
     /// the stored values.
     #[arg(long)]
     recompute_reference: bool,
@@ -215,6 +215,29 @@ fn one_line(text: &str) -> String {
     line
 }
 
+/// Reference computations expected to take longer than this are announced on stderr.
+const ANNOUNCE_SECONDS: f64 = 10.0;
+
+/// The reference values, with a spinner (terminal) while the independent reference is being
+/// integrated, and a one-line note of its expected duration when that is long.
+fn reference(radius: f64, recompute: bool) -> validate::Reference {
+    if !validate::reference::computes(radius, recompute) {
+        return validate::reference::compute(radius, recompute);
+    }
+    let expected = validate::reference::estimated_seconds(radius, recompute);
+    let about = if expected < 90.0 { format!("{expected:.0} s") } else { format!("{:.0} min", expected / 60.0) };
+    if expected > ANNOUNCE_SECONDS {
+        eprintln!(
+            "note: the independent face -> face reference for R = {radius} takes about {about} \
+             (2-core machine; only R = 1 is stored)"
+        );
+    }
+    let spinner = progress::Spinner::new(format!("face -> face reference for R = {radius}, about {about}"));
+    let r = validate::reference::compute(radius, recompute);
+    spinner.finish();
+    r
+}
+
 fn run_validate(args: &ValidateArgs) -> ExitCode {
     let mode = match (args.mode, args.tolerance) {
         (Some(ModeArg::Paper), _) | (None, None) => Mode::Paper,
@@ -253,7 +276,7 @@ fn run_validate(args: &ValidateArgs) -> ExitCode {
     }
     let threads = rayon::current_num_threads();
 
-    let reference = validate::reference::compute(config.radius, args.recompute_reference);
+    let reference = reference(config.radius, args.recompute_reference);
     if let validate::reference::Source::Unavailable(why) = &reference.source {
         eprintln!("warning: no independent face -> face reference: {why}");
     }

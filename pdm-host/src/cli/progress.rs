@@ -53,3 +53,30 @@ impl Progress for Bar {
         self.maybe_show();
     }
 }
+
+/// A spinner with the elapsed time for a computation that reports no units (the independent
+/// reference), on stderr when it is a terminal; hidden otherwise.
+pub struct Spinner {
+    bar: ProgressBar,
+}
+
+impl Spinner {
+    /// Starts spinning with `message`.
+    pub fn new(message: String) -> Self {
+        if !std::io::stderr().is_terminal() {
+            return Self { bar: ProgressBar::hidden() };
+        }
+        let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr_with_hz(4));
+        if let Ok(style) = ProgressStyle::with_template("{spinner} {msg} ({elapsed})") {
+            bar.set_style(style);
+        }
+        bar.set_message(message);
+        bar.enable_steady_tick(Duration::from_millis(250));
+        Self { bar }
+    }
+
+    /// Removes the spinner from the terminal.
+    pub fn finish(&self) {
+        self.bar.finish_and_clear();
+    }
+}

@@ -142,8 +142,12 @@ fn write(path: &Path, text: &str) -> Result<(), String> {
 pub fn run(args: &TradeoffArgs) -> Result<(), String> {
     let threads =
         if args.threads == 0 { std::thread::available_parallelism().map_or(1, usize::from) } else { args.threads };
+    // Every sweep runs on this pool; its stacks hold the largest capacity the engine
+    // instantiates (f64 needs more than f32), see `crate::validate::stack`.
+    let stack = crate::validate::stack::thread_stack::<f64>(pdm_kernel::MAX_ORDER * pdm_kernel::MAX_ORDER);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
+        .stack_size(stack)
         .build()
         .map_err(|e| format!("cannot start {threads} worker threads: {e}"))?;
     pool.install(|| run_in_pool(args))

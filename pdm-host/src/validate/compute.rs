@@ -305,7 +305,11 @@ where
 {
     match cfg.tolerance {
         Some(tol) => {
-            let settings = Adaptive { tolerance: T::from_f64(tol), max_order: ADAPTIVE_MAX_ORDER, max_depth: 6 };
+            let settings = Adaptive {
+                tolerance: T::from_f64(tol),
+                max_order: ADAPTIVE_MAX_ORDER,
+                max_depth: super::stack::ADAPTIVE_MAX_DEPTH,
+            };
             adaptive_exchange::<T, SA, SB, O, CAP>(a, b, settings, occluders)
                 .map(|e| (e.value, e.error, u64::from(!e.converged)))
         }

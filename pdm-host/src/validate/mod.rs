@@ -19,6 +19,7 @@ pub mod paper;
 pub mod reference;
 pub mod report;
 pub mod scene;
+pub mod stack;
 
 use std::fmt;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -73,6 +74,9 @@ impl Precision {
 pub const MAX_FACE_GRID: usize = 64;
 /// Largest sphere grid dimension (M or N) accepted.
 pub const MAX_SPHERE_GRID: usize = 256;
+/// Largest heap for the samples of paper mode ([`RunConfig::sample_memory`]): 1 GiB, e.g.
+/// a 256 × 256 sphere grid up to order 16 (3.8 GiB at order 32 are refused).
+pub const MAX_SAMPLE_MEMORY: usize = 1 << 30;
 /// Largest `--repeat`.
 pub const MAX_REPEAT: usize = 1000;
 
@@ -129,6 +133,22 @@ impl RunConfig {
                 return bad("tolerance", format!("{tol:e}"), "applies to --mode accurate only");
             }
         }
+        if self.mode == Mode::Paper {
+            let bytes = self.sample_memory();
+            if bytes > MAX_SAMPLE_MEMORY {
+                return bad(
+                    "sphere grid",
+                    format!("{m}x{n} with face grid {} and order {}", self.face_grid, self.order),
+                    &format!(
+                        "paper mode keeps the samples of all {} patches in memory, {:.1} GiB > {} GiB; \
+                         use a smaller grid or order",
+                        self.total_patches(),
+                        bytes as f64 / f64::from(1u32 << 30),
+                        MAX_SAMPLE_MEMORY >> 30
+                    ),
+                );
+            }
+        }
         Ok(())
     }
 
@@ -140,6 +160,13 @@ impl RunConfig {
         } else {
             0
         }
+    }
+
+    /// Heap bytes of the samples paper mode keeps (every patch sampled once, f64,
+    /// `PatchSamples` of [`capacity`]).
+    #[must_use]
+    pub fn sample_memory(&self) -> usize {
+        self.total_patches().saturating_mul(stack::samples_bytes::<f64>(capacity(self)))
     }
 
     /// Total patch count: sphere patches + 6 K².
@@ -163,6 +190,8 @@ pub enum ValidateError {
     },
     /// The reference could not be computed.
     Reference(String),
+    /// The worker threads could not be started.
+    Threads(String),
 }
 
 impl fmt::Display for ValidateError {
@@ -171,6 +200,7 @@ impl fmt::Display for ValidateError {
             Self::BadSetting(m) => f.write_str(m),
             Self::Kernel { context, error } => write!(f, "kernel error while {context}: {error}"),
             Self::Reference(m) => write!(f, "reference: {m}"),
+            Self::Threads(m) => f.write_str(m),
         }
     }
 }
@@ -245,9 +275,16 @@ pub fn median(mut xs: Vec<f64>) -> f64 {
     }
 }
 
-/// Runs the computation `repeat` times (at least once) in precision `T`.
+/// Runs the computation `repeat` times (at least once) in precision `T`, on a rayon pool of as
+/// many workers as the current pool has, with stacks sized for the run's sample capacity
+/// ([`stack::thread_stack`]; the calling thread only waits).
 pub fn run<T: Real>(cfg: &RunConfig, repeat: usize, progress: &dyn Progress) -> Result<Outcome, ValidateError> {
     cfg.check()?;
+    let pool = stack::pool::<T>(0, capacity(cfg)).map_err(ValidateError::Threads)?;
+    pool.install(|| run_repeated::<T>(cfg, repeat, progress))
+}
+
+fn run_repeated<T: Real>(cfg: &RunConfig, repeat: usize, progress: &dyn Progress) -> Result<Outcome, ValidateError> {
     let precision = if T::MANTISSA_DIGITS == 24 { Precision::F32 } else { Precision::F64 };
     let mut times = Vec::new();
     let mut last = None;
@@ -267,17 +304,23 @@ pub const MIN_TOLERANCE: f64 = 1e-13;
 /// Largest `--tolerance`.
 pub const MAX_TOLERANCE: f64 = 0.1;
 
-/// Picks the sample capacity for the order (CAP ≥ order²; the tolerance mode's orders go to
-/// 14).
+/// The sample capacity of a run: [`stack::capacity_for`] the largest order it samples
+/// (CAP ≥ order²; the tolerance mode's orders go to [`compute::ADAPTIVE_MAX_ORDER`] + 2).
+#[must_use]
+pub fn capacity(cfg: &RunConfig) -> usize {
+    let order = if cfg.tolerance.is_some() { cfg.order.max(compute::ADAPTIVE_MAX_ORDER + 2) } else { cfg.order };
+    stack::capacity_for(order)
+}
+
+/// Runs [`compute::run_once`] with the capacity [`capacity`] picks.
 fn run_dispatch<T: Real>(cfg: &RunConfig, progress: &dyn Progress) -> Result<(Values, Times), ValidateError> {
     use compute::run_once;
-    let order = if cfg.tolerance.is_some() { cfg.order.max(compute::ADAPTIVE_MAX_ORDER + 2) } else { cfg.order };
-    match order * order {
-        0..=25 => run_once::<T, 25>(cfg, progress),
-        26..=64 => run_once::<T, 64>(cfg, progress),
-        65..=144 => run_once::<T, 144>(cfg, progress),
-        145..=256 => run_once::<T, 256>(cfg, progress),
-        257..=576 => run_once::<T, 576>(cfg, progress),
+    match capacity(cfg) {
+        25 => run_once::<T, 25>(cfg, progress),
+        64 => run_once::<T, 64>(cfg, progress),
+        144 => run_once::<T, 144>(cfg, progress),
+        256 => run_once::<T, 256>(cfg, progress),
+        576 => run_once::<T, 576>(cfg, progress),
         _ => run_once::<T, { MAX_ORDER * MAX_ORDER }>(cfg, progress),
     }
 }

@@ -86,15 +86,60 @@ pub const STORED_R1: (f64, f64, f64, f64) =
     (0.19689310669952767, 0.15424993146874516, 6.071532165918825e-18, 2.8449465006019636e-16);
 
 /// The independent obstructed face → face factors: (adjacent, opposite, their uncertainties),
-/// from [`crate::reference::cube::cube_face_factors`] (side 6).
+/// from [`crate::reference::cube::face_pair_factor`] (side 6) for faces 1 → 2 and 1 → 6 (the
+/// two pairs of [`crate::reference::cube::cube_face_factors`]), computed concurrently.
 fn obstructed(radius: f64) -> Result<(f64, f64, f64, f64), ValidateError> {
-    let r = crate::reference::cube::cube_face_factors(SIDE, radius);
-    let all = [r.f_adjacent, r.f_opposite, r.f_adjacent_error, r.f_opposite_error];
+    use crate::reference::cube::face_pair_factor;
+    let (adj, opp) = rayon::join(|| face_pair_factor(SIDE, radius, 1, 2), || face_pair_factor(SIDE, radius, 1, 6));
+    let none = || ValidateError::Reference(format!("pdm_host::reference::cube gave no value for R = {radius}"));
+    let (adj, opp) = (adj.ok_or_else(none)?, opp.ok_or_else(none)?);
+    let all = [adj.value, opp.value, adj.error, opp.error];
     if all.iter().all(|x| x.is_finite()) {
-        Ok((r.f_adjacent, r.f_opposite, r.f_adjacent_error, r.f_opposite_error))
+        Ok((adj.value, opp.value, adj.error, opp.error))
     } else {
-        Err(ValidateError::Reference(format!("pdm_host::reference::cube gave no value for R = {radius}")))
+        Err(none())
     }
+}
+
+/// `true` if [`compute`] integrates the independent reference (R > 0, and R ≠ 1 or
+/// `recompute`); otherwise it is stored or closed-form and immediate.
+#[must_use]
+pub fn computes(radius: f64, recompute: bool) -> bool {
+    radius > 0.0 && (radius != 1.0 || recompute)
+}
+
+/// Times of [`compute`] by radius, seconds, on a 2-core machine: up to R = 2.8 the single-thread
+/// release times of `reference::cube`'s table (both face pairs one after the other, an upper
+/// bound now that they run concurrently); R = 2.9: the CPU time of both threads (185 s; 1204 s
+/// wall with the machine's load average at 12). Between them [`estimated_seconds`]
+/// interpolates log-linearly. The cost grows steeply as the sphere approaches the faces
+/// (R → 3); see VALIDATION.md.
+pub const MEASURED_SECONDS: [(f64, f64); 8] =
+    [(0.25, 2.1), (0.5, 1.4), (1.0, 1.7), (1.5, 2.6), (2.0, 7.4), (2.5, 19.0), (2.8, 46.0), (2.9, 185.0)];
+
+/// Roughly how long [`compute`] takes for `radius` on the machine of [`MEASURED_SECONDS`]
+/// (0 when nothing is integrated; beyond the last radius, extrapolated at the last log-slope).
+#[must_use]
+pub fn estimated_seconds(radius: f64, recompute: bool) -> f64 {
+    if !computes(radius, recompute) {
+        return 0.0;
+    }
+    let log_interp = |(r0, t0): (f64, f64), (r1, t1): (f64, f64)| {
+        let x = (radius - r0) / (r1 - r0);
+        (f64::ln(t0) + x * (f64::ln(t1) - f64::ln(t0))).exp()
+    };
+    let mut last = None;
+    for w in MEASURED_SECONDS.windows(2) {
+        let [a, b] = *w else { continue };
+        if radius <= a.0 {
+            return a.1;
+        }
+        if radius <= b.0 {
+            return log_interp(a, b);
+        }
+        last = Some((a, b));
+    }
+    last.map_or(0.0, |(a, b)| log_interp(a, b))
 }
 
 /// The reference values for a centred sphere of radius `radius` (0 = empty cube); for R = 1
@@ -103,23 +148,24 @@ fn obstructed(radius: f64) -> Result<(f64, f64, f64, f64), ValidateError> {
 #[must_use]
 pub fn compute(radius: f64, recompute: bool) -> Reference {
     let start = Instant::now();
-    let (adjacent, opposite, adjacent_uncertainty, opposite_uncertainty, source) = if radius == 1.0 && !recompute {
-        let (a, o, ua, uo) = STORED_R1;
-        (a, o, ua, uo, Source::Stored)
-    } else if radius > 0.0 {
-        match obstructed(radius) {
-            Ok((a, o, ua, uo)) => (a, o, ua, uo, Source::Independent),
-            Err(e) => (f64::NAN, f64::NAN, f64::NAN, f64::NAN, Source::Unavailable(e.to_string())),
-        }
-    } else {
-        (
-            perpendicular_rectangles(SIDE, SIDE, SIDE),
-            parallel_rectangles(SIDE, SIDE, SIDE),
-            0.0,
-            0.0,
-            Source::ClosedForm,
-        )
-    };
+    let (adjacent, opposite, adjacent_uncertainty, opposite_uncertainty, source) =
+        if !computes(radius, recompute) && radius > 0.0 {
+            let (a, o, ua, uo) = STORED_R1;
+            (a, o, ua, uo, Source::Stored)
+        } else if radius > 0.0 {
+            match obstructed(radius) {
+                Ok((a, o, ua, uo)) => (a, o, ua, uo, Source::Independent),
+                Err(e) => (f64::NAN, f64::NAN, f64::NAN, f64::NAN, Source::Unavailable(e.to_string())),
+            }
+        } else {
+            (
+                perpendicular_rectangles(SIDE, SIDE, SIDE),
+                parallel_rectangles(SIDE, SIDE, SIDE),
+                0.0,
+                0.0,
+                Source::ClosedForm,
+            )
+        };
     let mut face_to_face = [0.0; 15];
     let mut face_to_face_uncertainty = [0.0; 15];
     for ((&(a, b), f), u) in FACE_PAIRS.iter().zip(&mut face_to_face).zip(&mut face_to_face_uncertainty) {
@@ -153,6 +199,20 @@ mod tests {
         assert!((r.opposite - 0.1998248956983874).abs() < 1e-15);
         assert!(r.sum_rule_residual().abs() < 1e-14, "{}", r.sum_rule_residual());
         assert!(r.sphere_to_face.is_none());
+    }
+
+    #[test]
+    fn reference_time_estimate() {
+        assert_eq!(estimated_seconds(0.0, true), 0.0);
+        assert_eq!(estimated_seconds(1.0, false), 0.0);
+        assert!(estimated_seconds(1.0, true) > 0.0);
+        let mut last = 0.0;
+        for r in [2.0, 2.5, 2.8, 2.9, 2.99] {
+            let t = estimated_seconds(r, false);
+            assert!(t > last, "R = {r}: {t} s");
+            last = t;
+        }
+        assert!(estimated_seconds(2.9, false) > 60.0);
     }
 
     /// The stored R = 1 values are what the reference module computes (≈ 15 s).
