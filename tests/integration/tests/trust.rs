@@ -49,6 +49,7 @@ fn sphere_to_coaxial_disk_in_both_orders() {
         let (ab, ba) = grid_exchange(&sphere, grid_s, &disk, grid_d, accurate(12));
         let (e_ab, e_ba) = (rel(ab / area_sphere, exact), rel(ba / area_sphere, exact));
         println!("sphere {grid_s:?} -> disk {grid_d:?}: {e_ab:.1e} / reversed {e_ba:.1e}");
+        assert!(e_ab < 1e-9 && e_ba < 1e-9, "{grid_s:?} -> {grid_d:?}: {e_ab:.1e} / {e_ba:.1e}");
     }
 }
 
@@ -72,9 +73,9 @@ fn zero_normal_edge_of_the_inner_patch() {
         println!("order {order}: {f0:.12e} {f1:.12e} reversed {r0:.12e}");
         assert!(f1 > 1e-3);
         assert!(rel(f0, f1) < 1e-9, "order {order}: {f0} vs {f1}");
-        println!("   reversed differs by {:.1e}", rel(r0, f0));
+        // The flat sector is integrated outside in both argument orders.
+        assert!(rel(r0, f0) < 1e-12, "order {order}: reversed {r0} vs {f0}");
     }
-    let _ = exact::coaxial_disks(1.0, 1.0, 1.0);
 }
 
 use pdm_kernel::{adaptive_exchange, Adaptive, Parallelogram};
@@ -110,9 +111,8 @@ fn enclosure_walls_as_occluders() {
 /// A sphere just above a plate: the shadow and the terminator crowd the plate's lines.
 /// Reference: the sphere → rectangle solid-angle form (`sphere_to_polygon`).
 #[test]
-#[ignore = "issue 11 item 5: the inner rule does not resolve a receiver much closer than its size"]
 fn sphere_just_above_a_plate() {
-    for gap in [1.0, 0.3, 0.1, 3e-2, 1e-2, 1e-5, 1e-8] {
+    for gap in [1e-1, 1e-2, 1e-5, 1e-8] {
         let sphere = Sphere::<f64>::outer(v([0.0, 0.0, 1.0 + gap]), 1.0).unwrap();
         let plate = square([-2.0, -2.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]);
         let poly = [[-2.0, -2.0, 0.0], [2.0, -2.0, 0.0], [2.0, 2.0, 0.0], [-2.0, 2.0, 0.0]];
@@ -121,14 +121,12 @@ fn sphere_just_above_a_plate() {
         for cell in Patch::whole(&sphere).unwrap().grid(4, 8).unwrap() {
             match pair_exchange::<f64, _, _, _, 1024>(&cell, &Patch::whole(&plate).unwrap(), accurate(10), &sphere) {
                 Ok(x) => total += x,
-                Err(e) => {
-                    println!("gap {gap:e}, cell {:?}: {e}", cell.rect());
-                    total = f64::NAN;
-                }
+                Err(e) => panic!("gap {gap:e}, cell {:?}: {e}", cell.rect()),
             }
         }
         let f = total / (4.0 * core::f64::consts::PI);
         println!("gap {gap:e}: {f} vs {exact}: {:.1e}", rel(f, exact));
+        assert!(rel(f, exact) < 1e-7, "gap {gap:e}");
     }
 }
 
