@@ -1243,7 +1243,6 @@ fn bezier_down(z: f64) -> Kind {
 fn mark_known(v: Vec<Case>) -> Vec<Case> {
     // Numbers: f64 unless stated; "A·F" is the exchange, F = A·F / A_a.
     let known: &[(&str, &str)] = &[
-        ("cube floor->ceiling, 4 walls occluding", "issue 11 item 6: pair_exchange and adaptive_exchange Err(InvalidResult) (plain sum 0.19982489569838707, C-11 0.1998248956983874)"),
         ("facing unit squares gap 1e-1", "issue 11 item 5: pair_exchange F = 0.8352746 as Ok, C-11 0.8269945 (+1.0e-2), f32 the same"),
         ("strips 1e1 x 1e-1 at 1 (aspect 1e2)", "issue 11 item 5: pair_exchange F = 4.71728e-2, C-11 4.67084e-2 (+9.9e-3)"),
         ("strips 1e2 x 1e-2 at 1 (aspect 1e4)", "issue 11 item 5: pair_exchange F = 2.38169e-2, C-11 4.96805e-3 (+3.8); adaptive 5.48184e-3, estimate 4.1e-4 < actual 5.1e-4"),
@@ -1254,8 +1253,6 @@ fn mark_known(v: Vec<Case>) -> Vec<Case> {
         ("sphere 4x8 -> disk 1x4 below", "issue 11 item 1: pair_exchange A·F (a,b) 0.2273732, (b,a) 0.4600756, exact 0.1150 (21 s per direction)"),
         ("squares, disk between", "issue 11 item 4: pair_exchange not symmetric across a disk occluder: A·F 0.10093220 vs 0.10093497 (2.8e-5)"),
         ("squares, tilted plate between", "issue 11 item 4: pair_exchange not symmetric across a plate occluder: A·F 0.11093102 vs 0.11093300 (1.8e-5)"),
-        ("polar sphere cell phi<pi/4 -> disk sector above", "issue 11 item 1: pair_exchange F = 4.1e-39 (f32 1.2e-21), MC 0.14774 ± 5.6e-4 (plain 0.14745)"),
-        ("disk sector -> polar sphere cell (reversed)", "issue 11 item 1: pair_exchange F = 1.3e-39 (f32 3.7e-22), MC 0.08679 ± 4.5e-4 (plain 0.08637)"),
         ("sphere cell -> tilted plate crossing its horizon", "issue 11 item 1: pair_exchange not symmetric on a back-face-cut pair: A·F 0.40048607 vs 0.40048509 (2.4e-6)"),
         ("cylinder outer patch -> floor it stands on", "issue 11 item 1: pair_exchange F = 0.306866, MC 0.311273 ± 7.3e-4 (-1.4e-2); (b,a) gives 0.326438 (6 % asymmetric)"),
         ("sphere 1e-8 above a plate 4x4, self-occluding", "issue 11 item 6: pair_exchange (a,b) Err(CapacityExceeded { needed: 19, capacity: 18 }) after 56 s; (b,a) A·F 3.637067, exact Omega = 3.709 (-1.9 %)"),
@@ -1379,7 +1376,6 @@ macro_rules! single_case {
 }
 
 single_case! {
-    known_failing_cube_walls_occluding: "issue 11 item 6: Err(InvalidResult) with the cube's walls as occluders" => "cube floor->ceiling, 4 walls occluding";
     known_failing_squares_gap_1e_1: "issue 11 item 5: facing squares at gap 0.1 off by 1e-2 as Ok" => "facing unit squares gap 1e-1";
     known_failing_strips_aspect_1e2: "issue 11 item 5: strips of aspect 1e2 off by 1e-2" => "strips 1e1 x 1e-1 at 1 (aspect 1e2)";
     known_failing_strips_aspect_1e4: "issue 11 item 5: strips of aspect 1e4 off by 4x, adaptive estimate below the error" => "strips 1e2 x 1e-2 at 1 (aspect 1e4)";
@@ -1390,8 +1386,6 @@ single_case! {
     known_failing_sphere_grid_to_disk: "issue 11 item 1: sphere 4x8 -> disk 1x4 wrong both ways, 21 s" => "sphere 4x8 -> disk 1x4 below";
     known_failing_disk_occluder_symmetry: "issue 11 item 4: not symmetric across a disk occluder (2.8e-5)" => "squares, disk between";
     known_failing_plate_occluder_symmetry: "issue 11 item 4: not symmetric across a plate occluder (1.8e-5)" => "squares, tilted plate between";
-    known_failing_polar_cell_to_sector: "issue 11 item 1: polar sphere cell -> disk sector returns 4e-39" => "polar sphere cell phi<pi/4 -> disk sector above";
-    known_failing_sector_to_polar_cell: "issue 11 item 1: disk sector -> polar sphere cell returns 1e-39" => "disk sector -> polar sphere cell (reversed)";
     known_failing_sphere_cell_to_tilted_plate: "issue 11 item 1: not symmetric across the back-face cut (2.4e-6)" => "sphere cell -> tilted plate crossing its horizon";
     known_failing_cylinder_patch_to_floor: "issue 11 item 1: cylinder patch -> floor 1.4e-2 low, 6 % asymmetric" => "cylinder outer patch -> floor it stands on";
     known_failing_whole_cylinder_to_floor: "issue 11 item 3: whole periodic cylinder -> floor 4.4 % asymmetric" => "whole outer cylinder -> floor below (periodic)";
