@@ -103,8 +103,15 @@ pub struct Solution {
 }
 
 fn kernel_err(context: &'static str) -> impl Fn(PdmError) -> String {
-    move |e| format!("kernel error ({context}): {e}")
+    move |e| match e {
+        PdmError::InvalidResult | PdmError::Unresolvable => format!("{REFUSED} ({context}): {e}"),
+        _ => format!("kernel error ({context}): {e}"),
+    }
 }
+
+/// Start of the message of a sweep point whose value the kernel refused (outside the physical
+/// bounds, or beyond the working precision): the sweep records no row for it and goes on.
+pub const REFUSED: &str = "refused by the kernel";
 
 /// Solves `problem` by `method` with `occluders` (see the module docs).
 pub fn solve<T, SA, SB, O>(
