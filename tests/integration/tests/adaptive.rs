@@ -67,7 +67,6 @@ fn reaches_the_tolerance_with_an_honest_estimate() {
             // Honest: the actual error stays below the estimate (up to rounding, ≈ 1e-13 relative).
             assert!(actual <= e.error + 1e-13 * reference, "{name}: error {actual:e} above its estimate {:e}", e.error);
             // Flat pairs that see each other wholly take the contour form, touching ones the
-            // exact transforms: every tolerance here is reachable.
             // exact transforms: every tolerance down to 1e-10 is reached (at 1e-11 the contour
             // form's two-order estimate, 1e-11 on C-11 near, may stop just above it and say so).
             assert!(e.converged || tol < 1e-10, "{name}, tol {tol:e}: not converged");
