@@ -229,9 +229,7 @@ where
     match adjacency {
         Adjacency::SharedEdge { .. } | Adjacency::SharedVertex { .. } => {
             // The transforms test occlusion only at their sample points: with an occluder that
-            // may cut the pair, successive orders can agree on a wrong value (measured: cube
-            // faces 1 → 2 with the sphere, tolerance 1e-3, error 1.4e-3 against an estimate of
-            // 7.5e-4). Split both patches 2 × 2 until no occluder can cut a touching sub-pair;
+            // may cut the pair, successive orders can agree on a wrong value. Split both patches 2 × 2 until no occluder can cut a touching sub-pair;
             // the separate sub-pairs take the boundary-aware path.
             if depth < settings.max_depth && occluders.may_block_between(&a.enclosing_ball(), &b.enclosing_ball()) {
                 return split_both::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth);
@@ -442,8 +440,7 @@ where
 
 /// A pair that a visibility boundary crosses. The boundaries are placed into the inner rule
 /// ([`boundary_exchange_counted`]), but the outer integrand still has kinks where a boundary
-/// meets the inner patch's edges, and two Gauss orders can agree there by accident (measured:
-/// tolerance 1e-8 left 3e-6). So the error is estimated from the outer patch whole and split
+/// meets the inner patch's edges, and two Gauss orders can agree there by accident. So the error is estimated from the outer patch whole and split
 /// 2 × 2 at two orders ([`across_leaf`], module docs), and the pair is subdivided further while
 /// the estimate exceeds the tolerance.
 fn across_boundaries<T, SA, SB, O, const CAP: usize>(

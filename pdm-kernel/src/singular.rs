@@ -23,7 +23,7 @@
 //! where ζ exceeds another side's extent; the ratios then run to min(1, extent/ζ)) is covered by
 //! shells ζ ∈ [1, 4], [4, 16], … with breaks at the other extents. This is the cut of a long
 //! pair into near-square sub-pairs done inside the transform, allocation-free, at O(log aspect)
-//! extra shells (fuzz finding 7).
+//! extra shells.
 //!
 //! **Nearly folded pairs.** When the dihedral angle θ between the two patches is small (their
 //! normals at the edge nearly opposite), the kernel inside two of the pyramids peaks along the
@@ -32,9 +32,9 @@
 //! closest point is found on the other patch's coordinate line (golden section) and the ratio
 //! variables are split geometrically around it and towards u = 0 (widths: closest distance /
 //! line length), and ζ is also split upwards from the narrower side's extent and from the gap:
-//! exponential convergence down to θ ≈ 1°, with or without a gap (findings 2 and 3). Vertex
+//! exponential convergence down to θ ≈ 1°, with or without a gap. Vertex
 //! pairs do the same when one patch's edge from the vertex comes close to one of the other's
-//! (cells along a nearly folded edge, finding 5).
+//! (cells along a nearly folded edge).
 //!
 //! **Shared vertex.** Both patches are mapped so that the common corner is (0, 0); the 4-cube is
 //! split into four pyramids by its largest coordinate, Jacobian ζ³ (the singularity is 1/ζ²).
@@ -51,7 +51,7 @@
 //! three-quarter points coincide too (so the two parameterisations agree along it, as the
 //! transform requires). `Identical` needs all four corners, the centres and the normals there to
 //! agree. A contact the working precision cannot resolve (the rounding band not small against
-//! the shortest edge × the fold angle) is refused with `Err(Degenerate)` (finding 6).
+//! the shortest edge × the fold angle) is refused with `Err(Degenerate)`.
 
 use crate::error::PdmError;
 use crate::gauss::GaussRule;
