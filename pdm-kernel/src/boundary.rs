@@ -120,17 +120,7 @@ where
     let affine: Option<(Vec3<T>, Vec3<T>, Vec3<T>)> = None;
     // Whether an occluder can cut the integrand anywhere on b (not only at its Gauss points);
     // a flat b's corners give the smallest ball containing it.
-    let inner_bounds = match affine {
-        Some((o, et, es)) => {
-            let corner = |t: T, s: T| o + et.scale(t) + es.scale(s);
-            let center = corner((r.t0 + r.t1) * T::HALF, (r.s0 + r.s1) * T::HALF);
-            let radius = [(r.t0, r.s0), (r.t1, r.s0), (r.t0, r.s1), (r.t1, r.s1)]
-                .iter()
-                .fold(T::ZERO, |acc, &(t, s)| acc.max((corner(t, s) - center).norm()));
-            Ball { center, radius: radius * (T::ONE + T::GEOMETRY_TOLERANCE) }
-        }
-        None => b.enclosing_ball(),
-    };
+    let inner_bounds = part_ball(surface, affine, r)?;
     let use_occluders = occluders.may_block_between(&a.enclosing_ball(), &inner_bounds);
     let closed_form = match affine {
         Some((o, et, _)) => {
@@ -191,6 +181,26 @@ where
     }
     let value = crate::bounds::exchange(total * T::FRAC_1_PI, outer.area(), inner_samples.area())?;
     Ok((value, count.get()))
+}
+
+/// The smallest ball known to contain the part r of a surface: from its corners when the
+/// surface is flat (`affine`, its affine map), else [`Patch::enclosing_ball`].
+fn part_ball<T: Real, S: Surface<T> + ?Sized>(
+    surface: &S,
+    affine: Option<(Vec3<T>, Vec3<T>, Vec3<T>)>,
+    r: ParamRect<T>,
+) -> Result<Ball<T>, PdmError> {
+    Ok(match affine {
+        Some((o, et, es)) => {
+            let corner = |t: T, s: T| o + et.scale(t) + es.scale(s);
+            let center = corner((r.t0 + r.t1) * T::HALF, (r.s0 + r.s1) * T::HALF);
+            let radius = [(r.t0, r.s0), (r.t1, r.s0), (r.t0, r.s1), (r.t1, r.s1)]
+                .iter()
+                .fold(T::ZERO, |acc, &(t, s)| acc.max((corner(t, s) - center).norm()));
+            Ball { center, radius: radius * (T::ONE + T::GEOMETRY_TOLERANCE) }
+        }
+        None => Patch::new(surface, r)?.enclosing_ball(),
+    })
 }
 
 /// The nearest singular points just outside an interval, before and after it.
@@ -528,17 +538,7 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
 
     /// The smallest ball known to contain the part r of b (exact corners when flat).
     fn ball_of(&self, r: ParamRect<T>) -> Result<Ball<T>, PdmError> {
-        Ok(match self.affine {
-            Some((o, et, es)) => {
-                let corner = |t: T, s: T| o + et.scale(t) + es.scale(s);
-                let center = corner((r.t0 + r.t1) * T::HALF, (r.s0 + r.s1) * T::HALF);
-                let radius = [(r.t0, r.s0), (r.t1, r.s0), (r.t0, r.s1), (r.t1, r.s1)]
-                    .iter()
-                    .fold(T::ZERO, |acc, &(t, s)| acc.max((corner(t, s) - center).norm()));
-                Ball { center, radius: radius * (T::ONE + T::GEOMETRY_TOLERANCE) }
-            }
-            None => Patch::new(self.surface, r)?.enclosing_ball(),
-        })
+        part_ball(self.surface, self.affine, r)
     }
 
     /// J(p) = ∫_b visible (n̂_p·e)(−n_q·e)/L⁴ dq (without the 1/π) over the part r of b,
