@@ -255,9 +255,14 @@ where
                     occluded::<T, SB, SA, O, CAP>(b, a, settings.order, occluders)
                 }
             } else if straddles_curvature_cut(&sa, &sb) || near(&a.enclosing_ball(), &b.enclosing_ball()) {
-                // A curved outer patch sweeps its tangent plane across the inner one, which
-                // adds kinks to the outer integrand; a flat one does not: put it outside.
-                let (v, c) = if is_flat(b) && !is_flat(a) {
+                // The outer integrand is smooth where every outer point sees part of the inner
+                // patch; where some see none of it, the support's edge is a kink curve across
+                // the outer patch. Put outside the patch with fewer blind sample points; on a
+                // tie, the flat one (a curved outer patch sweeps its tangent plane across the
+                // inner one, which adds kinks; a flat one does not).
+                let (blind_a, blind_b) = (blind_points(&sa, &sb), blind_points(&sb, &sa));
+                let swap = blind_b < blind_a || (blind_b == blind_a && is_flat(b) && !is_flat(a));
+                let (v, c) = if swap {
                     boundary_exchange_counted::<T, SB, SA, (), CAP>(b, a, settings.order, &())?
                 } else {
                     boundary_exchange_counted::<T, SA, SB, (), CAP>(a, b, settings.order, &())?
@@ -269,6 +274,20 @@ where
             }
         }
     }
+}
+
+/// How many samples of `outer` see no sample of `inner` through the two-sided facing test
+/// (section 3.2): points where the inner integral of the boundary path would vanish.
+fn blind_points<T: Real, const CAP: usize>(outer: &PatchSamples<T, CAP>, inner: &PatchSamples<T, CAP>) -> usize {
+    outer
+        .iter()
+        .filter(|p| {
+            !inner.iter().any(|q| {
+                let e = q.point - p.point;
+                p.unit_normal.dot(e) > T::ZERO && q.unit_normal.dot(e) < T::ZERO
+            })
+        })
+        .count()
 }
 
 /// The boundary path with the outer patch split [`OCCLUDED_OUTER_SPLIT`]²: shadow edges
