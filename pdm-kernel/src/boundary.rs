@@ -813,9 +813,14 @@ fn closed_form_line<T: Real>(
     let mut lo = t0;
     let mut lo_id = 0u64;
     let mut status: Option<bool> = None;
+    // Candidates closer than this are one switch (two polynomials with a common root, e.g. a
+    // facing test and the tangent plane of a sphere occluder the point lies on): the piece
+    // between them is rounding, and the switch gets the smallest of their ids, so that the
+    // line's structure does not change with which root rounds first.
+    let merge = (t1 - t0) * end_inset::<T>();
     for &(hi, hi_id) in used.iter().chain(core::iter::once(&(t1, 0u64))) {
-        if !(hi > lo) {
-            lo_id = hi_id;
+        if !(hi > lo + merge) {
+            lo_id = lo_id.min(hi_id);
             continue;
         }
         let v = vis_at((lo + hi) * T::HALF);

@@ -47,7 +47,7 @@ impl Quadrature {
     }
 }
 
-/// The exchange integral A_a·F_{a→b} = (1/π) ∫∫ cos α_a cos α_b / (π L²)… i.e. eq. (15) times A_a,
+/// The exchange integral A_a·F_{a→b} = (1/π) ∫∫ cos α_a cos α_b / L² dA_b dA_a, i.e. eq. (15) times A_a,
 /// which is symmetric in a and b (reciprocity). Not divided by the area, so it adds over patches.
 pub fn exchange<T, O, const CA: usize, const CB: usize>(
     a: &PatchSamples<T, CA>,
@@ -81,8 +81,15 @@ where
     Ok(exchange(a, b, occluders)? / a.area())
 }
 
-/// F_{a→b} between two patches, sampling both (buffers of capacity `CAP` on the stack: use
-/// `CAP ≥ order²`, e.g. 25 for the paper's order 5).
+/// F_{a→b} between two patches by the PDM sum at the orders of `quadrature` (buffers of
+/// capacity `CAP` on the stack: use `CAP ≥ order²`, e.g. 25 for the paper's order 5).
+///
+/// Where the sum cannot resolve the pair it is not used: patches that touch along an edge or at
+/// a corner, or nearly ([`crate::classify_near`]), the same patch twice, and patches closer than
+/// [`RESOLVED_DISTANCE`] node spacings are integrated by [`crate::pair_exchange`] at the same
+/// order instead (the touching transforms, the self integral, the visibility-boundary path;
+/// `CAP ≥ (order + 1)²` keeps the order on a self pair, else it is lowered by one). The
+/// compile-time-order twins in [`crate::fixed`] are the bare sum and do not do this.
 ///
 /// ```
 /// use pdm_kernel::{form_factor_between, Parallelogram, Patch, Quadrature, vec3};
@@ -92,6 +99,12 @@ where
 /// let f = form_factor_between::<f64, _, _, _, 256>(
 ///     &Patch::whole(&lower)?, &Patch::whole(&upper)?, Quadrature::uniform(16), &())?;
 /// assert!((f - 0.1998248956983874).abs() < 1e-12);
+/// // Perpendicular squares sharing an edge (C-14: 0.2000437760754…): the bare sum at order 16
+/// // is 20 % off here; the shared-edge transform takes the pair.
+/// let wall = Parallelogram::new(vec3(0.0, 0.0, 0.0), vec3(0.0, 0.0, 1.0), vec3(1.0, 0.0, 0.0))?;
+/// let f = form_factor_between::<f64, _, _, _, 256>(
+///     &Patch::whole(&lower)?, &Patch::whole(&wall)?, Quadrature::uniform(16), &())?;
+/// assert!((f - 0.20004377607540316).abs() < 1e-12);
 /// # Ok::<(), pdm_kernel::PdmError>(())
 /// ```
 pub fn form_factor_between<T, SA, SB, O, const CAP: usize>(
@@ -108,7 +121,80 @@ where
 {
     let rule_a = GaussRule::<T>::new(quadrature.order_a)?;
     let rule_b = GaussRule::<T>::new(quadrature.order_b)?;
-    crate::fixed::form_factor_between_with_rules::<T, SA, SB, O, CAP>(a, b, &rule_a, &rule_b, occluders)
+    let (exchange, area) = resolved_exchange::<T, SA, SB, O, CAP>(a, b, &rule_a, &rule_b, occluders)?;
+    crate::bounds::form_factor(exchange / area)
+}
+
+/// Node spacings (the larger patch's sample diameter over its order) below which two patches
+/// are too close for the PDM sum: its integrand then varies within one spacing, and the error
+/// falls only slowly with the order (facing unit squares 0.1 apart: 1 % off at order 16).
+pub const RESOLVED_DISTANCE: usize = 2;
+
+/// A_a·F_{a→b} by the PDM sum where it resolves the pair, else by [`crate::pair_exchange`] at
+/// the same order (see [`form_factor_between`]); and A_a from a's samples.
+fn resolved_exchange<T, SA, SB, O, const CAP: usize>(
+    a: &Patch<'_, T, SA>,
+    b: &Patch<'_, T, SB>,
+    rule_a: &GaussRule<T>,
+    rule_b: &GaussRule<T>,
+    occluders: &O,
+) -> Result<(T, T), PdmError>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
+    let (plain, area) = plain_if_resolved::<T, SA, SB, O, CAP>(a, b, rule_a, rule_b, occluders)?;
+    if let Some(e) = plain {
+        return Ok((e, area));
+    }
+    let (adjacency, _) = crate::singular::classify_near(a, b);
+    let mut order = rule_a.order().max(rule_b.order()).max(2);
+    if adjacency == crate::singular::Adjacency::Identical && (order + 1) * (order + 1) > CAP {
+        order -= 1;
+    }
+    let settings = crate::pair::PairSettings { order, singular_order: order, boundaries: true };
+    Ok((crate::pair::pair_exchange::<T, SA, SB, O, CAP>(a, b, settings, occluders)?, area))
+}
+
+/// The PDM sum A_a·F_{a→b} if it resolves the pair (`None` if not: touching, identical or
+/// closer than [`RESOLVED_DISTANCE`] spacings), and A_a. Its two sample buffers live in this
+/// frame only, which returns before the pair path samples the patches again.
+#[inline(never)]
+fn plain_if_resolved<T, SA, SB, O, const CAP: usize>(
+    a: &Patch<'_, T, SA>,
+    b: &Patch<'_, T, SB>,
+    rule_a: &GaussRule<T>,
+    rule_b: &GaussRule<T>,
+    occluders: &O,
+) -> Result<(Option<T>, T), PdmError>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
+    let mut sa = PatchSamples::<T, CAP>::empty();
+    let mut sb = PatchSamples::<T, CAP>::empty();
+    sa.fill_with_rules(a, rule_a, rule_a)?;
+    sb.fill_with_rules(b, rule_b, rule_b)?;
+    if crate::singular::classify_near(a, b).0 != crate::singular::Adjacency::Separate {
+        return Ok((None, sa.area()));
+    }
+    let spacing = |s: &PatchSamples<T, CAP>, order: usize| s.bounds().radius * T::TWO / T::from_usize(order.max(1));
+    let limit = spacing(&sa, rule_a.order()).max(spacing(&sb, rule_b.order())) * T::from_usize(RESOLVED_DISTANCE);
+    let limit2 = limit * limit;
+    let close = sa.iter().any(|p| {
+        sb.iter().any(|q| {
+            let e = q.point - p.point;
+            e.dot(e) < limit2
+        })
+    });
+    if close {
+        return Ok((None, sa.area()));
+    }
+    Ok((Some(exchange(&sa, &sb, occluders)?), sa.area()))
 }
 
 /// F_{a→a}: the fraction of a concave patch's radiation that falls on the patch itself
@@ -135,11 +221,12 @@ where
 }
 
 /// Substructuring, eqs. (25)–(26): F_{A→B} = (1/A_A) Σ_{pa} Σ_{pb} A_pa F_{pa→pb} between the
-/// patches of grid `a` and grid `b`, each patch pair by eq. (16). A_A is the sum of the patch
+/// patches of grid `a` and grid `b`, each patch pair as by [`form_factor_between`] (the PDM sum,
+/// or [`crate::pair_exchange`] on the pairs the sum cannot resolve: adjacent and identical
+/// patches, patches closer than [`RESOLVED_DISTANCE`] spacings). A_A is the sum of the patch
 /// areas by eq. (12) with the same rule (so that a surface's factors to a closed enclosure sum
-/// to 1 up to the quadrature error). Every patch of `b` is re-sampled for each patch of `a`;
-/// nothing is allocated. Every pair uses the plain sum: for a concave surface against itself,
-/// identical patches need [`self_form_factor`] (or use [`crate::pair_exchange`] per pair).
+/// to 1 up to the quadrature error). Every patch is re-sampled for each pair; nothing is
+/// allocated.
 pub fn surface_form_factor<T, SA, SB, O, const CAP: usize>(
     a: PatchGrid<'_, T, SA>,
     b: PatchGrid<'_, T, SB>,
@@ -154,7 +241,18 @@ where
 {
     let rule_a = GaussRule::<T>::new(quadrature.order_a)?;
     let rule_b = GaussRule::<T>::new(quadrature.order_b)?;
-    crate::fixed::surface_form_factor_with_rules::<T, SA, SB, O, CAP>(a, b, &rule_a, &rule_b, occluders)
+    let mut total_area = T::ZERO;
+    let mut total_exchange = T::ZERO;
+    for pa in a {
+        let mut area = T::ZERO;
+        for pb in b.clone() {
+            let (e, area_a) = resolved_exchange::<T, SA, SB, O, CAP>(&pa, &pb, &rule_a, &rule_b, occluders)?;
+            total_exchange += e;
+            area = area_a;
+        }
+        total_area += area;
+    }
+    crate::bounds::form_factor(total_exchange / total_area)
 }
 
 /// Σ_k w_k Σ_l w_l (n̂_k·e / L²)(−n̂_l·e / L²) over mutually facing, unoccluded pairs.
