@@ -1,12 +1,17 @@
 //! Form factors with the Gauss rules chosen by the caller: a compile-time order (`…_fixed`) or
 //! rules built beforehand (`…_with_rules`), instead of the run-time orders of a [`Quadrature`].
 //!
-//! The functions of [`crate::form_factor`] take a [`Quadrature`], i.e. orders known only at run
+//! The functions of [`crate::form_factor`](mod@crate::form_factor) take a [`Quadrature`], i.e. orders known only at run
 //! time, and so link the Gauss tables of every order 1..=[`MAX_ORDER`] (4.2 KB in f32, 8.4 KB in
 //! f64). Firmware that uses one order can name it at compile time here and link that order's
 //! table only (40 B for order 5 in f32); a module that offers a range of orders can build its
-//! rules with [`GaussRule::new_up_to`] and link orders 1..=bound only. The results are
-//! bit-identical to the [`Quadrature`] versions: same rules, same sums in the same order.
+//! rules with [`GaussRule::new_up_to`] and link orders 1..=bound only.
+//!
+//! These are the bare PDM sum, nothing else linked: on pairs the sum resolves they are
+//! bit-identical to the [`Quadrature`] versions (same rules, same sums in the same order), but
+//! they do not hand touching, identical or too close patches to [`crate::pair_exchange`] as
+//! those do. There the bare sum is wrong (perpendicular squares sharing an edge, C-14: 20 % off
+//! at order 16): keep such pairs away from these functions, or use the [`Quadrature`] versions.
 //!
 //! ```
 //! use pdm_kernel::{form_factor_between, Parallelogram, Patch, Quadrature, vec3};

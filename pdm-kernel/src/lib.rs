@@ -20,9 +20,28 @@
 //! # Ok::<(), pdm_kernel::PdmError>(())
 //! ```
 //!
+//! ## Stack
+//!
+//! Nothing is allocated: the samples of a patch live on the stack in a [`PatchSamples`]`<T, CAP>`
+//! of 7·CAP values (7·CAP·`size_of::<T>()` bytes; 28 KiB for f32 at CAP 1024). What a call
+//! needs, by entry point (measured by `pdm-host/tests/stack_usage.rs`; the host figures include
+//! the test thread's own start-up frames, about 140 KiB; table in `pdm-host/VALIDATION.md`):
+//!
+//! - the plain sum ([`form_factor_between`], [`surface_form_factor`], [`fixed`]): two sample
+//!   buffers and a few KiB of frames — 2 664 B in total at order 5, CAP 25, f32 on a Cortex-M4
+//!   (`tests/firmware`). On the pairs it hands to [`pair_exchange`] (touching, identical, unresolved) the
+//!   latter's figure applies;
+//! - [`pair_exchange`]: about eight sample buffers plus 20 KiB (f32) / 160 KiB (f64) of frames
+//!   (host, release: 160 KiB at CAP 25, 380 KiB at CAP 1024 for f32);
+//! - [`adaptive_exchange`]: it recurses once per halving; about 43 sample buffers at depth 6
+//!   (host, release, f32 CAP 1024: 1.4 MiB), linear in the depth.
+//!
+//! Debug builds need about 3.7× these. Give a thread that runs the tolerance mode at a large
+//! capacity a stack to match (`std::thread::Builder::stack_size`); the `pdm` command does.
+//!
 //! Modules: [`gauss`] (tables), [`surface`] (surfaces and normals), [`patch`] (patches, grids,
 //! areas), [`samples`] (precomputed Gauss samples), [`visibility`] (curvature and occlusion
-//! tests), [`form_factor`] (the PDM sum and substructuring).
+//! tests), [`form_factor`](mod@form_factor) (the PDM sum and substructuring).
 
 #![no_std]
 #![forbid(unsafe_code)]

@@ -1,14 +1,14 @@
 //! One entry point for any pair of patches: picks the integration method the pair needs.
 //!
 //! - A patch whose image closes on itself (a whole disk, cylinder, cone or sphere as one
-//!   patch) is first cut at its seam into pieces ([`pieces`]); every pair of pieces is then
+//!   patch) is first cut at its seam into pieces (`pieces`); every pair of pieces is then
 //!   dispatched as below and the results are summed.
 //! - Touching pairs (shared edge or vertex, found by [`crate::singular::classify_near`], also
 //!   when they are only nearly touching) use the regularising
 //!   transforms of [`crate::singular`], converging exponentially with `singular_order`.
 //! - The same patch twice uses the interlaced-order self integral ([`crate::self_form_factor`]).
 //! - Two flat patches (parallelograms) that see each other wholly, with no occluder able to cut
-//!   between them and not in exact contact, use the contour form ([`crate::contour`]): exact at
+//!   between them and not in exact contact, use the contour form (`contour.rs`): exact at
 //!   any gap, from far apart down to nearly coincident.
 //! - Other separate pairs use the PDM sum at `order`. With `boundaries` on, a pair that
 //!   straddles a back-face cut, that an occluder may cut, or whose patches are closer than
@@ -65,6 +65,12 @@ impl PairSettings {
 /// the boundary path a is integrated outside (its Gauss points) and b inside (its visible part
 /// from each point of a), so the two argument orders agree to the quadrature error, not to the
 /// last digit. Divide by A_a ([`Patch::area`]) for F_{a→b}.
+///
+/// Accuracy at [`PairSettings::ACCURATE`]: about 1e-12 on smooth and touching pairs and on
+/// pairs straddling a back-face cut; across occluders the outer integral converges only
+/// algebraically (a shadow edge meeting the inner patch's corners and edges is a kink of the
+/// outer integrand), about 1e-5 to 1e-4 relative. For a guaranteed accuracy use
+/// [`crate::adaptive_exchange`], whose estimate bounds the error.
 ///
 /// Orientation: each patch radiates to the side its normal ∂g/∂t × ∂g/∂s points to (a
 /// surface's `Side`, or [`crate::Flipped`]). `Ok(0.0)` means no segment between the two

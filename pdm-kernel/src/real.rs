@@ -1,7 +1,7 @@
 //! The sealed floating-point trait every kernel algorithm is generic over.
 //!
 //! [`Real`] is implemented for `f32` and `f64` only (it is sealed): it carries the constants,
-//! the elementary functions (forwarded to [`crate::math`], which picks libm or micromath), the
+//! the elementary functions (forwarded to `math.rs`, which picks libm or micromath), the
 //! Gauss–Legendre tables of the width, and the tolerances the kernel uses for that width.
 
 use core::fmt::{Debug, Display};
