@@ -254,7 +254,12 @@ fn plain_rule_on_a_shared_edge_is_finite_and_in_unit_interval() {
                 last = bare;
             }
             // The shared-edge transform: 6.1e-5 at order 4, 4.5e-10 at 8 (singular_pairs.rs).
-            let allowed = match (is_f32, order) { (_, ..=7) => 1.0, (true, _) => 1e-5, (false, 8..=11) => 1e-9, _ => 1e-13 };
+            let allowed = match (is_f32, order) {
+                (_, ..=7) => 1.0,
+                (true, _) => 1e-5,
+                (false, 8..=11) => 1e-9,
+                _ => 1e-13,
+            };
             assert!((dispatched / reference - 1.0).abs() < allowed, "order {order}: {dispatched} vs {reference}");
         }
     }
