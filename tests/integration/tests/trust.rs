@@ -270,3 +270,24 @@ fn cylinder_wall_above_a_floor_in_both_orders() {
     // Monte Carlo (battery, 4e5 rays): 0.31127 ± 7.3e-4.
     assert!((a20 - 0.31127).abs() < 4.0 * 7.3e-4, "{a20}");
 }
+
+/// The tolerance mode on a touching pair when the order limit is reached before the
+/// tolerance: C-14 (perpendicular unit squares sharing an edge) at 1e-11 with `max_order` 8 /
+/// 10. Halving one square left a partial shared edge that the plain rule then integrated:
+/// 1.6e-3 off with an estimate of 1.0e-3. Now both squares are split, the cells share whole
+/// edges, and the estimate bounds the error whether or not the tolerance is met.
+#[test]
+fn touching_pair_split_at_the_order_limit() {
+    let floor = square([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]);
+    let wall = square([0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]);
+    let (a, b) = (Patch::whole(&floor).unwrap(), Patch::whole(&wall).unwrap());
+    let exact = exact::perpendicular_rectangles(1.0, 1.0, 1.0);
+    for (max_order, max_depth) in [(8, 1), (8, 2), (10, 2)] {
+        let settings = Adaptive { tolerance: 1e-11, max_order, max_depth };
+        let e = adaptive_exchange::<f64, _, _, _, 400>(&a, &b, settings, &()).unwrap();
+        let actual = (e.value - exact).abs();
+        println!("max order {max_order}, depth {max_depth}: error {actual:.1e}, estimate {:.1e}", e.error);
+        assert!(actual <= e.error, "error {actual:e} above the estimate {:e}", e.error);
+        assert!(rel(e.value, exact) < 1e-8);
+    }
+}
