@@ -185,12 +185,15 @@ where
     let spacing = |s: &PatchSamples<T, CAP>, order: usize| s.bounds().radius * T::TWO / T::from_usize(order.max(1));
     let limit = spacing(&sa, rule_a.order()).max(spacing(&sb, rule_b.order())) * T::from_usize(RESOLVED_DISTANCE);
     let limit2 = limit * limit;
-    let close = sa.iter().any(|p| {
-        sb.iter().any(|q| {
-            let e = q.point - p.point;
-            e.dot(e) < limit2
-        })
-    });
+    // The sample balls' gap bounds every sample distance from below: far pairs skip the scan.
+    let (ba, bb) = (sa.bounds(), sb.bounds());
+    let close = (ba.center - bb.center).norm() - ba.radius - bb.radius < limit
+        && sa.iter().any(|p| {
+            sb.iter().any(|q| {
+                let e = q.point - p.point;
+                e.dot(e) < limit2
+            })
+        });
     if close {
         return Ok((None, sa.area()));
     }
