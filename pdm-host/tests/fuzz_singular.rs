@@ -1369,7 +1369,6 @@ fn seed_20260601_unit_squares_folded_to_1_degree_with_a_gap() {
 /// coincident near the edge), tolerance 1e-3: `adaptive_exchange` returns `Err(InvalidResult)`
 /// (the bounds check refusing the plain rule's value). Asserts the correct behaviour.
 #[test]
-#[ignore = "open: adaptive.rs refuses a nearly folded separate pair"]
 fn adaptive_nearly_folded_separate_pair_is_refused() {
     let case = plain_case(1.0, 1.0, 1.0, 1.0, 0.08749701870019223);
     let (floor, flap) = case.build::<f64>().unwrap();
@@ -1391,7 +1390,6 @@ fn adaptive_nearly_folded_separate_pair_is_refused() {
 /// contour 0.44385973829, actual error 3.6e-9 > estimate 1.1e-9 (32352 evaluations: orders 6
 /// and 8). Prints the touching transform's error per order; asserts the correct behaviour.
 #[test]
-#[ignore = "open: the tolerance mode's estimate on a touching pair is below the actual error"]
 fn adaptive_touching_pair_estimate_below_the_actual_error() {
     let case = plain_case(28.569596826911052, 0.760867382867785, 1.0, 0.9350669727448926, 0.0);
     let (floor, flap) = case.build::<f64>().unwrap();
@@ -1481,4 +1479,29 @@ fn seed_20261201_cells_along_an_edge_folded_to_1_degree_with_a_gap() {
     );
     assert!(rel(f, reference) < 1e-9, "{f} vs {reference}");
     assert!(rel(y, x) < 1e-11, "{x:e} vs {y:e}");
+}
+
+/// Finding 17 (adaptive property, seed 20261201, case 95): floor 1.58 × 1 and flap 1.58 × 0.925
+/// at 33.1°, lifted by 0.428 of the shortest side along its plane (`Separate`, both flat: the
+/// contour form at orders 8 and 12): value 0.58196347 against the contour reference
+/// 0.58196789, actual error 4.4e-6 above the estimate 9.3e-7.
+#[test]
+fn seed_20261201_separate_folded_pair_estimate_bounds_the_error() {
+    let case = plain_case(33.106917823023984, 1.5809435130744167, 1.0, 0.9250976900655828, 0.428218182080178);
+    let (floor, flap) = case.build::<f64>().unwrap();
+    let (a, b) = (floor.cell(0, 1), flap.cell(0, 1));
+    let (pf, pp) = case.polygons();
+    let reference = contour::polygon_form_factor(&pf, &pp) * case.l * case.w;
+    println!("classify_near {:?}", classify_near(&a, &b));
+    for order in [4, 8, 12, 16, 20, 24, 32] {
+        let x = pair_exchange::<f64, _, _, _, 1024>(&a, &b, settings(order, 12), &()).unwrap();
+        println!("order {order}: {x:.16e}, error {:+.2e}", x - reference);
+    }
+    for tolerance in [1e-3, 1e-6, 1e-9] {
+        let e = adaptive_exchange::<f64, _, _, _, 256>(&a, &b, Adaptive { tolerance, max_order: 12, max_depth: 4 }, &())
+            .unwrap();
+        let actual = (e.value - reference).abs();
+        println!("adaptive {tolerance:e}: {e:?}, actual error {actual:.2e}");
+        assert!(actual <= e.error, "actual {actual:e} > estimate {:e}", e.error);
+    }
 }

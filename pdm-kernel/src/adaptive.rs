@@ -62,13 +62,12 @@
 //! work. The sample buffers hold at most `max_order`² points, so `CAP` ≥ `max_order`²
 //! (`Err(CapacityExceeded)` otherwise, also checked first).
 
-use crate::boundary::boundary_exchange_counted;
 use crate::error::PdmError;
-use crate::form_factor::exchange;
+use crate::form_factor::exchange_unchecked;
 use crate::patch::Patch;
 use crate::real::Real;
 use crate::samples::PatchSamples;
-use crate::singular::{classify_near, touching_exchange, Adjacency};
+use crate::singular::{classify_near, touching_unchecked, Adjacency};
 use crate::surface::{ParamRect, Surface};
 use crate::visibility::Occluder;
 
@@ -76,7 +75,7 @@ use crate::visibility::Occluder;
 /// buffer on the stack: they live in non-inlined frames that return before it recurses.
 pub const MAX_DEPTH: u32 = 24;
 
-/// Smallest accepted `max_order` (touching pairs start at orders 6 and 8).
+/// Smallest accepted `max_order` (touching pairs compare orders 4, 6 and 8).
 const MIN_ORDER: usize = 8;
 
 /// Factor on the differences that estimate algebraically converging pairs (module docs).
@@ -191,10 +190,9 @@ where
         Ok(())
     })?;
     let (area_a, area_b) = (a.area(settings.max_order)?, b.area(settings.max_order)?);
-    e.value = crate::bounds::exchange(e.value, area_a, area_b)?;
-    if !e.error.is_finite() {
-        return Err(PdmError::InvalidResult);
-    }
+    // The leaves are unchecked approximations: the total may overshoot [0, min(A_a, A_b)] by
+    // its error, and is clamped there; beyond its error it is refused.
+    e.value = crate::bounds::exchange_within(e.value, e.error, area_a, area_b)?;
     Ok(e)
 }
 
@@ -214,16 +212,18 @@ where
     let (adjacency, gap) = classify_near(a, b);
     // Two flat patches that see each other wholly: the contour form at two orders.
     #[cfg(feature = "closed-form")]
-    if adjacency == Adjacency::Separate || (adjacency != Adjacency::Identical && gap > T::ZERO) {
+    if crate::pair::contour_applies(adjacency, gap) {
         let lo_order = 8usize.min(settings.max_order);
-        if let Some(lo) = crate::pair::flat_pair(a, b, lo_order, occluders) {
-            let (lo, n_lo, _) = lo?;
-            let hi_order = (2 * lo_order).min(settings.max_order.max(lo_order + 1));
-            if let Some(hi) = crate::pair::flat_pair(a, b, hi_order, occluders) {
-                let (hi, n_hi, rounding) = hi?;
-                let difference = (hi - lo).abs() + rounding;
-                return Ok(Estimate::leaf(hi, difference, settings.tolerance, n_lo.saturating_add(n_hi)));
-            }
+        // Where the contour terms cancel beyond the working precision (`Unresolvable`: f32
+        // cells close together), the 4-D path below takes the pair instead if its Gauss rules
+        // resolve the pair at `max_order`; otherwise (long strips close together, whose ends
+        // no node comes near) two approximations can agree on a wrong value, and the refusal
+        // stands.
+        match contour_leaf(a, b, lo_order, settings, occluders) {
+            Some(Err(PdmError::Unresolvable))
+                if adjacency != Adjacency::Separate || resolved::<T, SA, SB, CAP>(a, b, settings.max_order)? => {}
+            None => {}
+            Some(result) => return result,
         }
     }
     match adjacency {
@@ -232,7 +232,7 @@ where
             // may cut the pair, successive orders can agree on a wrong value. Split both patches 2 × 2 until no occluder can cut a touching sub-pair;
             // the separate sub-pairs take the boundary-aware path.
             if depth < settings.max_depth && occluders.may_block_between(&a.enclosing_ball(), &b.enclosing_ball()) {
-                return split_both::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth);
+                return split_both::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, 0);
             }
             let per_order = |p: usize| -> u64 {
                 let p4 = (p as u64).pow(4);
@@ -242,13 +242,67 @@ where
                     4 * p4
                 }
             };
-            let eval = |p: usize| Ok((touching_exchange(a, b, adjacency, gap, p, occluders)?, per_order(p)));
-            by_order_doubling::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, eval, 6, settings.max_order)
+            let eval = |p: usize| Ok((touching_unchecked(a, b, adjacency, gap, p, occluders)?, per_order(p)));
+            by_order_doubling::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, eval, 4, Split::Both)
         }
         // Not split (module docs): the leaf says whether it met the tolerance.
         Adjacency::Identical => identical::<T, SA, O, CAP>(a, settings, occluders),
         Adjacency::Separate => separate::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth),
     }
+}
+
+/// The contour form ([`crate::pair::flat_pair`]) at `lo_order` and twice that (within
+/// `max_order`): the difference plus the rounding bound is the estimate. `None` if the pair is
+/// not a flat pair that sees itself wholly.
+#[cfg(feature = "closed-form")]
+fn contour_leaf<T, SA, SB, O>(
+    a: &Patch<'_, T, SA>,
+    b: &Patch<'_, T, SB>,
+    lo_order: usize,
+    settings: Adaptive<T>,
+    occluders: &O,
+) -> Option<Result<Estimate<T>, PdmError>>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
+    let (lo, n_lo, _) = match crate::pair::flat_pair(a, b, lo_order, occluders)? {
+        Ok(x) => x,
+        Err(e) => return Some(Err(e)),
+    };
+    let hi_order = (2 * lo_order).min(settings.max_order.max(lo_order + 1));
+    let (hi, n_hi, rounding) = match crate::pair::flat_pair(a, b, hi_order, occluders)? {
+        Ok(x) => x,
+        Err(e) => return Some(Err(e)),
+    };
+    let difference = (hi - lo).abs() + rounding;
+    Some(Ok(Estimate::leaf(hi, difference, settings.tolerance, n_lo.saturating_add(n_hi))))
+}
+
+/// Whether the Gauss rules of order `order` resolve the pair: its closest sample points are at
+/// least [`crate::form_factor::RESOLVED_DISTANCE`] node spacings apart (a spacing: the
+/// patch's sample-ball diameter / order), so the kernel varies over several nodes of each rule.
+#[inline(never)]
+fn resolved<T, SA, SB, const CAP: usize>(a: &Patch<'_, T, SA>, b: &Patch<'_, T, SB>, order: usize) -> Result<bool, PdmError>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+{
+    let sa = PatchSamples::<T, CAP>::new(a, order)?;
+    let sb = PatchSamples::<T, CAP>::new(b, order)?;
+    let spacing = |s: &PatchSamples<T, CAP>| s.bounds().radius * T::TWO / T::from_usize(order);
+    let limit = spacing(&sa).max(spacing(&sb)) * T::from_usize(crate::form_factor::RESOLVED_DISTANCE);
+    let limit2 = limit * limit;
+    let close = sa.iter().any(|p| {
+        sb.iter().any(|q| {
+            let e = q.point - p.point;
+            e.dot(e) < limit2
+        })
+    });
+    Ok(!close)
 }
 
 /// The same patch twice by the self rule ([`crate::self_form_factor`], orders p and p + 1 with
@@ -265,7 +319,10 @@ where
     O: Occluder<T> + ?Sized,
 {
     let p = settings.max_order - 1;
-    let self_ff = |order: usize| crate::form_factor::self_form_factor::<T, S, O, CAP>(a, order, occluders);
+    let self_ff = |order: usize| -> Result<T, PdmError> {
+        let (exchange, area) = crate::form_factor::self_exchange_unchecked::<T, S, O, CAP>(a, order, occluders)?;
+        Ok(exchange / area)
+    };
     let hi = self_ff(p)?;
     let lower = [p - 1, p - 2, p - 3, p / 2];
     let mut difference = T::ZERO;
@@ -308,8 +365,15 @@ where
     let p = p.min(settings.max_order);
     let sa = PatchSamples::<T, CAP>::new(a, p)?;
     let sb = PatchSamples::<T, CAP>::new(b, p)?;
-    let across =
-        occluders.may_block_between(&a.enclosing_ball(), &b.enclosing_ball()) || straddles_curvature_cut(&sa, &sb);
+    let (ball_a, ball_b) = (a.enclosing_ball(), b.enclosing_ball());
+    // Patches closer than their size: the plain rule's nodes do not resolve the kernel's peak,
+    // and two orders can agree by accident (a separate pair folded to 33° with the gap a
+    // quarter of its size: orders 10 and 12 agreed to 9e-7 with the value 4.4e-6 off). The
+    // boundary path refines the inner patch towards each close outer point, and its estimate
+    // compares the outer patch whole and split.
+    let across = occluders.may_block_between(&ball_a, &ball_b)
+        || crate::pair::near(&ball_a, &ball_b)
+        || straddles_curvature_cut(&sa, &sb);
     Ok((p, across))
 }
 
@@ -329,7 +393,7 @@ where
 {
     let sa = PatchSamples::<T, CAP>::new(a, order)?;
     let sb = PatchSamples::<T, CAP>::new(b, order)?;
-    Ok((exchange(&sa, &sb, occluders)?, (sa.len() * sb.len()) as u64))
+    Ok((exchange_unchecked(&sa, &sb, occluders)?, (sa.len() * sb.len()) as u64))
 }
 
 fn separate<T, SA, SB, O, const CAP: usize>(
@@ -352,13 +416,34 @@ where
     // Below order 4 two successive orders can agree by accident; start there.
     let p = p.max(4).min(settings.max_order - 2);
     let eval = |order: usize| plain::<T, SA, SB, O, CAP>(a, b, order, occluders);
-    by_order_doubling::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, eval, p, settings.max_order)
+    by_order_doubling::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, eval, p, Split::Larger)
+}
+
+/// How a pair that reaches `max_order` is subdivided.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Split {
+    /// The larger patch in two ([`split`]): separate pairs.
+    Larger,
+    /// Both patches 2 × 2 ([`split_both`]): touching pairs, whose cells along the contact must
+    /// share whole edges or corners to be recognised as touching again (halving one patch
+    /// leaves a partial shared edge, which the plain rule would integrate across). Touching
+    /// pairs also need two comparisons (three orders, from 4) before they are accepted: their
+    /// low orders are cheap, and the convergence rate of the transforms varies with the
+    /// geometry.
+    Both,
 }
 
 /// Evaluates the pair at orders p, p + 2, … (`eval` gives the value and its evaluations) until
-/// two successive values agree to the tolerance (the difference is the estimate); when the
-/// next order would pass `last_order`, splits the pair instead (or, at the depth limit,
-/// returns the last value with its estimate, not converged).
+/// the estimate meets the tolerance; when the next order would pass `max_order`, splits the
+/// pair as `how` says (or, at the depth limit, returns the last value with its estimate, not
+/// converged).
+///
+/// The estimate of Q_{p+2} is max(d₂, √(d₁·d₂)) with d₂ = |Q_{p+2} − Q_p| and d₁ =
+/// |Q_p − Q_{p−2}| (d₂ alone on the first comparison): convergence that stalls for a step —
+/// one part of the integrand converging at a slower rate than the rest — makes d₂ alone
+/// accidentally small (a touching pair at 28.6°: orders 4 / 6 / 8 off by 8.4e-5 / −2.5e-9 /
+/// −3.6e-9, d₂ = 1.1e-9 below the error); the geometric mean with the previous step holds the
+/// estimate at the rate seen so far.
 #[allow(clippy::too_many_arguments)]
 fn by_order_doubling<T, SA, SB, O, const CAP: usize>(
     a: &Patch<'_, T, SA>,
@@ -368,7 +453,7 @@ fn by_order_doubling<T, SA, SB, O, const CAP: usize>(
     depth: u32,
     eval: impl Fn(usize) -> Result<(T, u64), PdmError>,
     first_order: usize,
-    last_order: usize,
+    how: Split,
 ) -> Result<Estimate<T>, PdmError>
 where
     T: Real,
@@ -376,19 +461,28 @@ where
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
+    let last_order = settings.max_order;
     let mut p = first_order;
     let (mut prev, mut evaluations) = eval(p)?;
+    let mut previous_difference: Option<T> = None;
     loop {
         let next_p = p + 2;
         let (next, n) = eval(next_p)?;
         evaluations = evaluations.saturating_add(n);
-        let leaf = Estimate::leaf(next, next - prev, settings.tolerance, evaluations);
-        if leaf.converged || (next_p + 2 > last_order && depth >= settings.max_depth) {
-            return Ok(leaf);
+        let difference = (next - prev).abs();
+        let estimate = previous_difference.map_or(difference, |d1| difference.max((d1 * difference).sqrt()));
+        let leaf = Estimate::leaf(next, estimate, settings.tolerance, evaluations);
+        let accepted = leaf.converged && (how == Split::Larger || previous_difference.is_some());
+        if accepted || (next_p + 2 > last_order && depth >= settings.max_depth) {
+            return Ok(Estimate { converged: accepted, ..leaf });
         }
         if next_p + 2 > last_order {
-            return split::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, evaluations);
+            return match how {
+                Split::Larger => split::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, evaluations),
+                Split::Both => split_both::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, evaluations),
+            };
         }
+        previous_difference = Some(difference);
         prev = next;
         p = next_p;
     }
@@ -419,12 +513,12 @@ where
     let r = a.rect();
     let mut evaluations = 0u64;
     let mut at = |order: usize| -> Result<(T, T), PdmError> {
-        let (whole, n) = boundary_exchange_counted::<T, SA, SB, O, CAP>(a, b, order, occluders)?;
+        let (whole, n, _, _) = crate::boundary::boundary_unchecked::<T, SA, SB, O, CAP>(a, b, order, occluders)?;
         evaluations = evaluations.saturating_add(n);
         let mut quarters = T::ZERO;
         for k in 0..4 {
             let child = Patch::new(a.surface(), r.cell(k / 2, k % 2, 2, 2))?;
-            let (v, n) = boundary_exchange_counted::<T, SA, SB, O, CAP>(&child, b, order, occluders)?;
+            let (v, n, _, _) = crate::boundary::boundary_unchecked::<T, SA, SB, O, CAP>(&child, b, order, occluders)?;
             quarters += v;
             evaluations = evaluations.saturating_add(n);
         }
@@ -439,7 +533,7 @@ where
 }
 
 /// A pair that a visibility boundary crosses. The boundaries are placed into the inner rule
-/// ([`boundary_exchange_counted`]), but the outer integrand still has kinks where a boundary
+/// ([`crate::boundary_exchange_counted`]), but the outer integrand still has kinks where a boundary
 /// meets the inner patch's edges, and two Gauss orders can agree there by accident. So the error is estimated from the outer patch whole and split
 /// 2 × 2 at two orders ([`across_leaf`], module docs), and the pair is subdivided further while
 /// the estimate exceeds the tolerance.
@@ -463,8 +557,8 @@ where
     split::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, leaf.evaluations)
 }
 
-/// Splits both patches 2 × 2 at their parameter midpoints and recurses on the 16 sub-pairs
-/// (touching pairs stay edge- or vertex-adjacent when both maps divide the shared edge in
+/// Splits both patches 2 × 2 at their parameter midpoints and recurses on the 16 sub-pairs;
+/// `spent` evaluations are carried into the total (touching pairs stay edge- or vertex-adjacent when both maps divide the shared edge in
 /// proportion, as the built-in surfaces' grids do).
 fn split_both<T, SA, SB, O, const CAP: usize>(
     a: &Patch<'_, T, SA>,
@@ -472,6 +566,7 @@ fn split_both<T, SA, SB, O, const CAP: usize>(
     settings: Adaptive<T>,
     occluders: &O,
     depth: u32,
+    spent: u64,
 ) -> Result<Estimate<T>, PdmError>
 where
     T: Real,
@@ -479,7 +574,7 @@ where
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
-    let mut total = Estimate::zero(0);
+    let mut total = Estimate::zero(spent);
     let (ra, rb) = (a.rect(), b.rect());
     for k in 0..4 {
         let ca = Patch::new(a.surface(), ra.cell(k / 2, k % 2, 2, 2))?;

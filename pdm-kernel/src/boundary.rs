@@ -108,6 +108,24 @@ where
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
+    let (value, count, area_a, area_b) = boundary_unchecked::<T, SA, SB, O, CAP>(a, b, order, occluders)?;
+    Ok((crate::bounds::exchange(value, area_a, area_b)?, count))
+}
+
+/// [`boundary_exchange_counted`] without the bounds check (finite only; see
+/// `bounds::finite`), with the two patches' areas at `order`.
+pub(crate) fn boundary_unchecked<T, SA, SB, O, const CAP: usize>(
+    a: &Patch<'_, T, SA>,
+    b: &Patch<'_, T, SB>,
+    order: usize,
+    occluders: &O,
+) -> Result<(T, u64, T, T), PdmError>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
     let count = core::cell::Cell::new(0u64);
     let outer = PatchSamples::<T, CAP>::new(a, order)?;
     let inner_samples = PatchSamples::<T, CAP>::new(b, order)?; // validates b (area, finiteness)
@@ -179,8 +197,8 @@ where
         };
         total += sample.weight * j;
     }
-    let value = crate::bounds::exchange(total * T::FRAC_1_PI, outer.area(), inner_samples.area())?;
-    Ok((value, count.get()))
+    let value = crate::bounds::finite(total * T::FRAC_1_PI)?;
+    Ok((value, count.get(), outer.area(), inner_samples.area()))
 }
 
 /// The smallest ball known to contain the part r of a surface: from its corners when the

@@ -32,6 +32,41 @@ pub(crate) fn exchange<T: Real>(value: T, area_a: T, area_b: T) -> Result<T, Pdm
     }
 }
 
+/// An intermediate quadrature value (a part of a sum, one of several approximations the
+/// tolerance mode compares): finite, else `Err(InvalidResult)`. Its bounds are checked once,
+/// on the value the entry point returns: an approximation may overshoot the bound of its own
+/// part by its quadrature error while the total is right.
+#[inline]
+pub(crate) fn finite<T: Real>(value: T) -> Result<T, PdmError> {
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(PdmError::InvalidResult)
+    }
+}
+
+/// `value` with an estimated absolute `error` as an exchange between areas `area_a`, `area_b`:
+/// within `error` (plus the rounding band) of [0, min(A_a, A_b)] it is clamped into that
+/// interval (which can only bring it closer to the true value, so `error` still bounds it);
+/// farther out, or not finite, `Err(InvalidResult)`.
+pub(crate) fn exchange_within<T: Real>(value: T, error: T, area_a: T, area_b: T) -> Result<T, PdmError> {
+    let bound = if area_a < area_b { area_a } else { area_b };
+    if !(error >= T::ZERO) || !error.is_finite() {
+        return Err(PdmError::InvalidResult);
+    }
+    if value >= -error && value <= bound * (T::ONE + rounding_band::<T>()) + error {
+        Ok(if value < T::ZERO {
+            T::ZERO
+        } else if value < bound {
+            value
+        } else {
+            bound
+        })
+    } else {
+        Err(PdmError::InvalidResult)
+    }
+}
+
 /// `value` as a form factor: `Err(InvalidResult)` unless finite and in [0, 1] (up to the
 /// rounding band, where it is clamped to 1).
 pub(crate) fn form_factor<T: Real>(value: T) -> Result<T, PdmError> {
@@ -52,6 +87,13 @@ mod tests {
         assert_eq!(exchange(-1e-300_f64, 1.0, 1.0), Err(PdmError::InvalidResult));
         assert_eq!(exchange(f64::NAN, 1.0, 1.0), Err(PdmError::InvalidResult));
         assert_eq!(exchange(0.1_f64, 0.0, 1.0), Err(PdmError::InvalidResult));
+        // With an error estimate: clamped within it, refused beyond it.
+        assert_eq!(exchange_within(1.01_f64, 0.02, 1.0, 2.0), Ok(1.0));
+        assert_eq!(exchange_within(-0.01_f64, 0.02, 1.0, 2.0), Ok(0.0));
+        assert_eq!(exchange_within(1.03_f64, 0.02, 1.0, 2.0), Err(PdmError::InvalidResult));
+        assert_eq!(exchange_within(-0.03_f64, 0.02, 1.0, 2.0), Err(PdmError::InvalidResult));
+        assert_eq!(exchange_within(0.5_f64, f64::NAN, 1.0, 2.0), Err(PdmError::InvalidResult));
+        assert_eq!(exchange_within(f64::NAN, 0.1, 1.0, 2.0), Err(PdmError::InvalidResult));
         assert_eq!(form_factor(1.0 + 1e-5_f32), Ok(1.0));
         assert_eq!(form_factor(1.001_f32), Err(PdmError::InvalidResult));
     }

@@ -58,12 +58,26 @@ where
     T: Real,
     O: Occluder<T> + ?Sized,
 {
+    crate::bounds::exchange(exchange_unchecked(a, b, occluders)?, a.area(), b.area())
+}
+
+/// [`exchange`] without the bounds check (finite only): a part of a larger sum, or one of the
+/// approximations the pair methods compare (see `bounds::finite`).
+pub(crate) fn exchange_unchecked<T, O, const CA: usize, const CB: usize>(
+    a: &PatchSamples<T, CA>,
+    b: &PatchSamples<T, CB>,
+    occluders: &O,
+) -> Result<T, PdmError>
+where
+    T: Real,
+    O: Occluder<T> + ?Sized,
+{
     let sum = if occluders.may_block_between(&a.bounds(), &b.bounds()) {
         pdm_sum(a, b, Some(occluders))
     } else {
         pdm_sum::<T, O, CA, CB>(a, b, None)
     };
-    crate::bounds::exchange(sum * T::FRAC_1_PI, a.area(), b.area())
+    crate::bounds::finite(sum * T::FRAC_1_PI)
 }
 
 /// F_{a→b} between two sampled patches by eqs. (15)–(16) with the 1/π and Jacobians restored,
@@ -215,12 +229,25 @@ where
     S: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
+    let (e, area) = self_exchange_unchecked::<T, S, O, CAP>(patch, order, occluders)?;
+    crate::bounds::form_factor(e / area)
+}
+
+/// A_a·F_{a→a} by [`self_form_factor`]'s rule without the bounds check, and the area it is
+/// normalised by (the mean of the two copies' areas, which keeps reciprocity exact).
+pub(crate) fn self_exchange_unchecked<T, S, O, const CAP: usize>(
+    patch: &Patch<'_, T, S>,
+    order: usize,
+    occluders: &O,
+) -> Result<(T, T), PdmError>
+where
+    T: Real,
+    S: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
     let a = PatchSamples::<T, CAP>::new(patch, order)?;
     let b = PatchSamples::<T, CAP>::new(patch, order.saturating_add(1))?;
-    // Use the order-(p+1) area for the normalisation of the symmetric exchange: both copies
-    // estimate the same area; take the mean to keep reciprocity exact.
-    let e = exchange(&a, &b, occluders)?;
-    crate::bounds::form_factor(e * T::TWO / (a.area() + b.area()))
+    Ok((exchange_unchecked(&a, &b, occluders)?, (a.area() + b.area()) * T::HALF))
 }
 
 /// Substructuring, eqs. (25)–(26): F_{A→B} = (1/A_A) Σ_{pa} Σ_{pb} A_pa F_{pa→pb} between the

@@ -21,13 +21,13 @@
 //! it is returned.
 
 use crate::adaptive::straddles_curvature_cut;
-use crate::boundary::boundary_exchange_counted;
+use crate::boundary::boundary_unchecked;
 use crate::error::PdmError;
-use crate::form_factor::exchange;
+use crate::form_factor::exchange_unchecked;
 use crate::patch::Patch;
 use crate::real::Real;
 use crate::samples::PatchSamples;
-use crate::singular::{classify_near, touching_exchange, Adjacency};
+use crate::singular::{classify_near, touching_unchecked, Adjacency};
 use crate::surface::Surface;
 #[cfg(feature = "closed-form")]
 use crate::vec3::Vec3;
@@ -138,7 +138,7 @@ where
 /// `true` if two patches are closer than the larger one's radius: the plain rule's error then
 /// falls slowly with the order (the kernel's nearest singularity is within a patch size), and the
 /// boundary path, which refines the inner patch towards each outer point, takes the pair.
-fn near<T: Real>(a: &crate::samples::Ball<T>, b: &crate::samples::Ball<T>) -> bool {
+pub(crate) fn near<T: Real>(a: &crate::samples::Ball<T>, b: &crate::samples::Ball<T>) -> bool {
     (a.center - b.center).norm() - a.radius - b.radius < a.radius.max(b.radius)
 }
 
@@ -224,29 +224,34 @@ where
     let p4 = (settings.order as u64).pow(4);
     let (adjacency, gap) = classify_near(a, b);
     #[cfg(feature = "closed-form")]
-    if settings.boundaries && (adjacency == Adjacency::Separate || (adjacency != Adjacency::Identical && gap > T::ZERO))
-    {
-        if let Some(result) = flat_pair(a, b, settings.order, occluders) {
-            return result.map(|(value, count, _)| (value, count));
+    if settings.boundaries && contour_applies(adjacency, gap) {
+        match flat_pair(a, b, settings.order, occluders) {
+            // A touching pair whose contour terms cancel beyond the working precision: the
+            // transforms below take it.
+            Some(Err(PdmError::Unresolvable)) if adjacency != Adjacency::Separate => {}
+            Some(result) => return result.map(|(value, count, _)| (value, count)),
+            None => {}
         }
     }
     match adjacency {
         Adjacency::SharedEdge { .. } | Adjacency::SharedVertex { .. } => {
             let q4 = (settings.singular_order as u64).pow(4);
             let count = if matches!(adjacency, Adjacency::SharedEdge { .. }) { 6 * q4 } else { 4 * q4 };
-            Ok((touching_exchange(a, b, adjacency, gap, settings.singular_order, occluders)?, count))
+            Ok((touching_unchecked(a, b, adjacency, gap, settings.singular_order, occluders)?, count))
         }
         Adjacency::Identical => {
-            let f = crate::form_factor::self_form_factor::<T, SA, O, CAP>(a, settings.order, occluders)?;
-            let sa = PatchSamples::<T, CAP>::new(a, settings.order)?;
+            let (exchange, area) =
+                crate::form_factor::self_exchange_unchecked::<T, SA, O, CAP>(a, settings.order, occluders)?;
             let q = (settings.order * (settings.order + 1)) as u64;
-            Ok((f * sa.area(), q * q))
+            // The mean area of the rule's two copies keeps the value reciprocal; rescaled to the
+            // area the entry point divides by.
+            Ok((exchange / area * a.area(settings.order)?, q * q))
         }
         Adjacency::Separate => {
             let sa = PatchSamples::<T, CAP>::new(a, settings.order)?;
             let sb = PatchSamples::<T, CAP>::new(b, settings.order)?;
             if !settings.boundaries {
-                return Ok((exchange(&sa, &sb, occluders)?, p4));
+                return Ok((exchange_unchecked(&sa, &sb, occluders)?, p4));
             }
             // The sample balls decide for the plain sum; the integrand is smooth only if no
             // occluder cuts any segment between the patches (enclosing balls).
@@ -268,15 +273,15 @@ where
                 // inner one, which adds kinks; a flat one does not).
                 let (blind_a, blind_b) = (blind_points(&sa, &sb), blind_points(&sb, &sa));
                 let swap = blind_b < blind_a || (blind_b == blind_a && is_flat(b) && !is_flat(a));
-                let (v, c) = if swap {
-                    boundary_exchange_counted::<T, SB, SA, (), CAP>(b, a, settings.order, &())?
+                let (v, c, _, _) = if swap {
+                    boundary_unchecked::<T, SB, SA, (), CAP>(b, a, settings.order, &())?
                 } else {
-                    boundary_exchange_counted::<T, SA, SB, (), CAP>(a, b, settings.order, &())?
+                    boundary_unchecked::<T, SA, SB, (), CAP>(a, b, settings.order, &())?
                 };
                 Ok((v, c.saturating_add(p4)))
             } else {
                 // Smooth pair: nothing to place into the rule, no occluder can cut it.
-                Ok((exchange(&sa, &sb, &())?, 2 * p4))
+                Ok((exchange_unchecked(&sa, &sb, &())?, 2 * p4))
             }
         }
     }
@@ -315,7 +320,7 @@ where
     let n = OCCLUDED_OUTER_SPLIT;
     for k in 0..n * n {
         let child = Patch::new(a.surface(), r.cell(k / n, k % n, n, n))?;
-        let (v, c) = boundary_exchange_counted::<T, SA, SB, O, CAP>(&child, b, order, occluders)?;
+        let (v, c, _, _) = boundary_unchecked::<T, SA, SB, O, CAP>(&child, b, order, occluders)?;
         total += v;
         count = count.saturating_add(c);
     }
@@ -352,6 +357,21 @@ fn is_flat<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>) -> bool {
     let Some(centre) = at(T::HALF, T::HALF) else { return false };
     let limit = T::ONE - T::from_f64(64.0) * T::EPSILON;
     [(lo, lo), (hi, lo), (lo, hi), (hi, hi)].iter().all(|&(x, y)| at(x, y).is_some_and(|n| n.dot(centre) >= limit))
+}
+
+/// Whether a pair of the given contact may take the contour form (if both patches are flat
+/// and see each other wholly, [`flat_pair`]): separate and nearly touching pairs, and pairs
+/// touching at a vertex in exact contact — which covers a partial shared edge (a short edge
+/// lying along a longer one from a common corner, a non-conforming grid), whose line of
+/// contact the vertex transform does not expect (it converges only algebraically there). Two
+/// patches sharing a whole edge in exact contact keep the edge transform; the same patch twice
+/// the self rule.
+pub(crate) fn contour_applies<T: Real>(adjacency: Adjacency, gap: T) -> bool {
+    match adjacency {
+        Adjacency::Separate | Adjacency::SharedVertex { .. } => true,
+        Adjacency::SharedEdge { .. } => gap > T::ZERO,
+        Adjacency::Identical => false,
+    }
 }
 
 /// Two flat patches (parallelograms) that see each other wholly — each in the closed half-space

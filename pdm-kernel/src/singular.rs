@@ -491,6 +491,27 @@ where
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
+    let value = touching_unchecked(a, b, adjacency, gap, order, occluders)?;
+    // 0 ≤ A_a·F_ab ≤ min(A_a, A_b) (`Err(InvalidResult)` otherwise, rounding clamped).
+    let order = order.max(2);
+    crate::bounds::exchange(value, a.area(order)?, b.area(order)?)
+}
+
+/// [`touching_exchange`] without the bounds check (finite only; see `bounds::finite`).
+pub(crate) fn touching_unchecked<T, SA, SB, O>(
+    a: &Patch<'_, T, SA>,
+    b: &Patch<'_, T, SB>,
+    adjacency: Adjacency,
+    gap: T,
+    order: usize,
+    occluders: &O,
+) -> Result<T, PdmError>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
     let rule = GaussRule::<T>::new(order)?;
     if gap >= T::MAX {
         return Err(PdmError::Degenerate);
@@ -534,9 +555,7 @@ where
         }
         Adjacency::Separate | Adjacency::Identical => return Err(PdmError::Degenerate),
     };
-    // 0 ≤ A_a·F_ab ≤ min(A_a, A_b) (`Err(InvalidResult)` otherwise, rounding clamped).
-    let order = order.max(2);
-    crate::bounds::exchange(sum * T::FRAC_1_PI, a.area(order)?, b.area(order)?)
+    crate::bounds::finite(sum * T::FRAC_1_PI)
 }
 
 /// Length of the local coordinate line from `p` to `q` (a 4-segment polyline).
