@@ -335,14 +335,16 @@ where
 }
 
 /// The starting order of a separate pair from its geometry (module docs, item 2), capped at
-/// `max_order`, and whether the pair straddles a visibility boundary at that order.
+/// `max_order`, whether the pair straddles a visibility boundary at that order (or is closer
+/// than its size), and whether b should be the outer patch of the boundary path (unoccluded
+/// pairs, [`crate::pair::outer_is_b`]; across occluders a stays outside).
 #[inline(never)]
 fn separate_plan<T, SA, SB, O, const CAP: usize>(
     a: &Patch<'_, T, SA>,
     b: &Patch<'_, T, SB>,
     settings: Adaptive<T>,
     occluders: &O,
-) -> Result<(usize, bool), PdmError>
+) -> Result<(usize, bool, bool), PdmError>
 where
     T: Real,
     SA: Surface<T> + ?Sized,
@@ -371,10 +373,10 @@ where
     // quarter of its size: orders 10 and 12 agreed to 9e-7 with the value 4.4e-6 off). The
     // boundary path refines the inner patch towards each close outer point, and its estimate
     // compares the outer patch whole and split.
-    let across = occluders.may_block_between(&ball_a, &ball_b)
-        || crate::pair::near(&ball_a, &ball_b)
-        || straddles_curvature_cut(&sa, &sb);
-    Ok((p, across))
+    let occluded = occluders.may_block_between(&ball_a, &ball_b);
+    let across = occluded || crate::pair::near(&ball_a, &ball_b) || straddles_curvature_cut(&sa, &sb);
+    let swap = across && !occluded && crate::pair::outer_is_b(a, b, &sa, &sb);
+    Ok((p, across, swap))
 }
 
 /// The plain PDM sum at `order` on both patches and its evaluations.
@@ -409,9 +411,14 @@ where
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
-    let (p, across) = separate_plan::<T, SA, SB, O, CAP>(a, b, settings, occluders)?;
+    let (p, across, swap) = separate_plan::<T, SA, SB, O, CAP>(a, b, settings, occluders)?;
     if across {
-        return across_boundaries::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth);
+        // A_a·F_{a→b} = A_b·F_{b→a}: the outer patch is the one the plan chose.
+        return if swap {
+            across_boundaries::<T, SB, SA, O, CAP>(b, a, settings, occluders, depth)
+        } else {
+            across_boundaries::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth)
+        };
     }
     // Below order 4 two successive orders can agree by accident; start there.
     let p = p.max(4).min(settings.max_order - 2);

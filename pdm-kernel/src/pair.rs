@@ -266,13 +266,7 @@ where
                     occluded::<T, SB, SA, O, CAP>(b, a, settings.order, occluders)
                 }
             } else if straddles_curvature_cut(&sa, &sb) || near(&a.enclosing_ball(), &b.enclosing_ball()) {
-                // The outer integrand is smooth where every outer point sees part of the inner
-                // patch; where some see none of it, the support's edge is a kink curve across
-                // the outer patch. Put outside the patch with fewer blind sample points; on a
-                // tie, the flat one (a curved outer patch sweeps its tangent plane across the
-                // inner one, which adds kinks; a flat one does not).
-                let (blind_a, blind_b) = (blind_points(&sa, &sb), blind_points(&sb, &sa));
-                let swap = blind_b < blind_a || (blind_b == blind_a && is_flat(b) && !is_flat(a));
+                let swap = outer_is_b(a, b, &sa, &sb);
                 let (v, c, _, _) = if swap {
                     boundary_unchecked::<T, SB, SA, (), CAP>(b, a, settings.order, &())?
                 } else {
@@ -284,6 +278,85 @@ where
                 Ok((exchange_unchecked(&sa, &sb, &())?, 2 * p4))
             }
         }
+    }
+}
+
+/// Which patch of a separate, unoccluded pair the boundary path should integrate outside
+/// (`true`: b). The outer integrand is smooth where every outer point sees part of the inner
+/// patch; where some see none of it, the support's edge is a kink curve across the outer
+/// patch: the patch with fewer blind sample points goes outside. On a tie, where an outer
+/// point comes closer to the inner patch's edges than the outer rule's node spacing, the
+/// inner integral changes on that distance's scale there (a disk 0.05 below a larger one:
+/// across the small disk's rim), which the outer rule cannot resolve: the patch whose points
+/// stay farther from the other's edges, in its own node spacings, goes outside (the small
+/// disk over the large one). Otherwise the flat one (a curved outer patch sweeps its tangent
+/// plane across the inner one, which adds kinks; a flat one does not).
+pub(crate) fn outer_is_b<T, SA, SB, const CAP: usize>(
+    a: &Patch<'_, T, SA>,
+    b: &Patch<'_, T, SB>,
+    sa: &PatchSamples<T, CAP>,
+    sb: &PatchSamples<T, CAP>,
+) -> bool
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+{
+    let (blind_a, blind_b) = (blind_points(sa, sb), blind_points(sb, sa));
+    if blind_a != blind_b {
+        return blind_b < blind_a;
+    }
+    let (clear_a, clear_b) = (edge_clearance(sa, b), edge_clearance(sb, a));
+    if clear_a.min(clear_b) < T::ONE && clear_a != clear_b {
+        return clear_b > clear_a;
+    }
+    is_flat(b) && !is_flat(a)
+}
+
+/// Segments per edge of the polylines that stand for a patch's edges in [`edge_clearance`].
+const EDGE_SEGMENTS: usize = 16;
+
+/// The smallest distance from a sample of `outer` to the edges of `inner` (16-segment
+/// polylines), in node spacings of the outer rule (its sample ball's diameter / order).
+fn edge_clearance<T, S, const CAP: usize>(outer: &PatchSamples<T, CAP>, inner: &Patch<'_, T, S>) -> T
+where
+    T: Real,
+    S: Surface<T> + ?Sized,
+{
+    let r = inner.rect();
+    let g = inner.surface();
+    let n = T::from_usize(EDGE_SEGMENTS);
+    let edge_point = |edge: usize, k: usize| {
+        let x = T::from_usize(k) / n;
+        let (t, s) = match edge {
+            0 => (r.t0 + (r.t1 - r.t0) * x, r.s0),
+            1 => (r.t1, r.s0 + (r.s1 - r.s0) * x),
+            2 => (r.t0 + (r.t1 - r.t0) * x, r.s1),
+            _ => (r.t0, r.s0 + (r.s1 - r.s0) * x),
+        };
+        g.point(t, s)
+    };
+    let mut nearest = T::MAX;
+    for edge in 0..4 {
+        let mut prev = edge_point(edge, 0);
+        for k in 1..=EDGE_SEGMENTS {
+            let next = edge_point(edge, k);
+            let d = next - prev;
+            let d2 = d.dot(d);
+            for p in outer.iter() {
+                let w = p.point - prev;
+                let along = if d2 > T::ZERO { (w.dot(d) / d2).max(T::ZERO).min(T::ONE) } else { T::ZERO };
+                nearest = nearest.min((w - d.scale(along)).norm());
+            }
+            prev = next;
+        }
+    }
+    let order = T::from_usize(outer.len()).sqrt().max(T::ONE);
+    let spacing = outer.bounds().radius * T::TWO / order;
+    if spacing > T::ZERO {
+        nearest / spacing
+    } else {
+        T::MAX
     }
 }
 
