@@ -2,19 +2,26 @@
 //!
 //! [`adaptive_exchange`] returns A_a·F_{a→b} with an error estimate, whether that estimate met
 //! the tolerance, and the number of integrand evaluations it took. Per pair it
-//! 1. classifies the pair ([`classify_near`]): touching pairs use the regularising transforms,
-//!    raising the order by 2 until two successive results agree to the tolerance; the same
+//! 1. classifies the pair ([`classify_near`]): flat pairs that see each other wholly use the
+//!    contour form at two orders (where its terms cancel beyond the working precision, the
+//!    paths below take the pair if their rules resolve it, else `Err(Unresolvable)`);
+//!    touching pairs use the regularising transforms, raising the order by 2 from 4; the same
 //!    patch twice uses [`self_form_factor`](crate::self_form_factor) (see below);
 //! 2. for separate pairs, starts from an order chosen from the geometry — the Gauss error on an
 //!    integrand whose nearest singularity lies at distance d from patches of size h falls like
 //!    ρ^(−2p) with ρ ≈ 1 + 2d/h, so p₀ = ⌈ln(1/tol) / (2 ln ρ)⌉ (clamped to 2…12);
 //! 3. skips the occlusion tests when no occluder can cut a segment between the two patches'
-//!    bounding balls (`Occluder::may_block_between`), and places visibility boundaries into the
-//!    rule ([`boundary`](crate::boundary)) only when the pair straddles one (some sample pairs
-//!    visible, some not, or an occluder that may cut);
-//! 4. compares orders p and p + 2; if they disagree by more than the tolerance after
-//!    `max_order`, splits the larger patch in two across its longer side and recurses
-//!    (depth ≤ `max_depth`, so at most 2^max_depth leaf pairs; no allocation). Sides are
+//!    bounding balls (`Occluder::may_block_between`), and takes the boundary path
+//!    ([`boundary`](crate::boundary): visibility boundaries placed into the inner rule, the
+//!    inner patch refined towards close outer points) when the pair straddles a boundary
+//!    (some sample pairs visible, some not, or an occluder that may cut) or the patches are
+//!    closer than their size; without occluders the patch whose points stay farther from the
+//!    other's edges goes outside (`pair::outer_is_b`);
+//! 4. compares orders p, p + 2, …; when the estimate is still above the tolerance at
+//!    `max_order`, splits the pair and recurses — a separate pair's larger patch in two across
+//!    its longer side, a touching pair's both patches 2 × 2 (so that the cells along the
+//!    contact share whole edges and corners again) — to depth ≤ `max_depth` (no
+//!    allocation). Sides are
 //!    measured by arc length (a 12-segment polyline along each edge and the mid-line of the
 //!    parameter rectangle), so a side that closes on itself — the θ side of a whole disk or
 //!    cylinder, whose corner chord is zero — is halved like any other.
@@ -30,9 +37,13 @@
 //! the tolerance. A caller who needs the tolerance checks the flag (or compares `error` with
 //! its own budget).
 //!
-//! * Smooth separate pairs and touching pairs (exponential convergence in the order): the
-//!   difference between the last two orders, which bounds the higher order's error by a wide
-//!   margin (checked against closed forms in the tests).
+//! * Smooth separate pairs and touching pairs (exponential convergence in the order): with
+//!   d₂ the difference between the last two orders and d₁ the one before, max(d₂, √(d₁·d₂))
+//!   (d₂ alone on a separate pair's first comparison, whose start order the geometry chose);
+//!   touching pairs compare at least three orders. The geometric mean covers convergence that
+//!   stalls for a step (checked against closed forms and the contour integral in the tests).
+//! * Flat pairs by the contour form: the difference between orders 8 and 16 (within
+//!   `max_order`) plus the bound on the rounding of the cancelling terms.
 //! * Pairs across visibility boundaries: the outer integrand keeps kinks (a shadow edge meeting
 //!   an inner edge), so successive orders — and a patch and its halves — can agree by
 //!   accident. Four approximations are computed: the outer patch whole and split 2 × 2, each

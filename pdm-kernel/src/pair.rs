@@ -8,14 +8,17 @@
 //!   transforms of [`crate::singular`], converging exponentially with `singular_order`.
 //! - The same patch twice uses the interlaced-order self integral ([`crate::self_form_factor`]).
 //! - Two flat patches (parallelograms) that see each other wholly, with no occluder able to cut
-//!   between them and not in exact contact, use the contour form (`contour.rs`): exact at
-//!   any gap, from far apart down to nearly coincident.
+//!   between them and not sharing a whole edge in exact contact, use the contour form
+//!   (`contour.rs`): exact at any gap, from far apart down to nearly coincident, and for a
+//!   partial shared edge (a short edge along a longer one from a common corner).
 //! - Other separate pairs use the PDM sum at `order`. With `boundaries` on, a pair that
 //!   straddles a back-face cut, that an occluder may cut, or whose patches are closer than
 //!   their size gets the visibility boundaries placed into the inner rule and the inner patch
 //!   refined towards each outer point ([`crate::boundary`]; the outer patch is also split
 //!   [`OCCLUDED_OUTER_SPLIT`]² when an occluder may cut); smooth, distant, unoccludable pairs
-//!   keep the plain sum.
+//!   keep the plain sum. Without occluders the outer patch is the one with fewer points that
+//!   see none of the other, then the one whose points stay farther from the other's edges
+//!   (`outer_is_b`).
 //!
 //! Every value is checked against the physical bounds 0 ≤ A_a·F_{a→b} ≤ min(A_a, A_b) before
 //! it is returned.
