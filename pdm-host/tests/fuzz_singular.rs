@@ -1487,8 +1487,9 @@ fn seed_20261201_separate_folded_pair_estimate_bounds_the_error() {
         println!("order {order}: {x:.16e}, error {:+.2e}", x - reference);
     }
     for tolerance in [1e-3, 1e-6, 1e-9] {
-        let e = adaptive_exchange::<f64, _, _, _, 256>(&a, &b, Adaptive { tolerance, max_order: 12, max_depth: 4 }, &())
-            .unwrap();
+        let e =
+            adaptive_exchange::<f64, _, _, _, 256>(&a, &b, Adaptive { tolerance, max_order: 12, max_depth: 4 }, &())
+                .unwrap();
         let actual = (e.value - reference).abs();
         println!("adaptive {tolerance:e}: {e:?}, actual error {actual:.2e}");
         assert!(actual <= e.error, "actual {actual:e} > estimate {:e}", e.error);

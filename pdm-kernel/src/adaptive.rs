@@ -296,7 +296,11 @@ where
 /// least [`crate::form_factor::RESOLVED_DISTANCE`] node spacings apart (a spacing: the
 /// patch's sample-ball diameter / order), so the kernel varies over several nodes of each rule.
 #[inline(never)]
-fn resolved<T, SA, SB, const CAP: usize>(a: &Patch<'_, T, SA>, b: &Patch<'_, T, SB>, order: usize) -> Result<bool, PdmError>
+fn resolved<T, SA, SB, const CAP: usize>(
+    a: &Patch<'_, T, SA>,
+    b: &Patch<'_, T, SB>,
+    order: usize,
+) -> Result<bool, PdmError>
 where
     T: Real,
     SA: Surface<T> + ?Sized,

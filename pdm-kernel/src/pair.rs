@@ -483,7 +483,14 @@ where
         }
         Some(ahead)
     };
-    if !(side(&cb, ca[0], na)? && side(&ca, cb[0], nb)?) {
+    let (b_ahead, a_ahead) = (side(&cb, ca[0], na)?, side(&ca, cb[0], nb)?);
+    if !(b_ahead && a_ahead) {
+        // Each within the other's plane to the working precision while facing each other: a
+        // gap below the geometry's resolution (f32 plates 1e-6 apart), which no path can
+        // integrate (the 4-D rules would return a value off by percents).
+        if !b_ahead && !a_ahead && na.dot(nb) < T::ZERO {
+            return Some(Err(PdmError::Unresolvable));
+        }
         return None;
     }
     if occluders.may_block_between(&a.enclosing_ball(), &b.enclosing_ball()) {

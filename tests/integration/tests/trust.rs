@@ -333,3 +333,35 @@ fn partial_shared_edge() {
         assert!(e.converged && actual <= tolerance * exact);
     }
 }
+
+/// Facing plates closer than f32 resolves: unit squares half overlapping, 1e-6 apart. Each lay
+/// within the other's plane to the working precision, so the contour form did not take them
+/// and the 4-D rules returned `Ok` 1.3e-2 off (exact 0.375, C-11 algebra: the overlap is
+/// ½ × ¾ of a unit square, and the gap's correction is below 1e-5). Now `Err(Unresolvable)`;
+/// at a 1e-3 gap the f32 value is right.
+#[test]
+fn f32_facing_plates_below_the_resolution() {
+    use pdm_kernel::{adaptive_exchange, Adaptive, Parallelogram, PdmError};
+    let plates = |gap: f32| {
+        (
+            Parallelogram::<f32>::new(vec3(0.0, 0.0, 0.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0)).unwrap(),
+            Parallelogram::<f32>::new(vec3(0.5, 0.25, gap), vec3(0.0, 1.0, 0.0), vec3(1.0, 0.0, 0.0)).unwrap(),
+        )
+    };
+    let s = accurate(12);
+    let (a, b) = plates(1e-6);
+    let (pa, pb) = (Patch::whole(&a).unwrap(), Patch::whole(&b).unwrap());
+    let x = pair_exchange::<f32, _, _, _, 256>(&pa, &pb, s, &());
+    let y = pair_exchange::<f32, _, _, _, 256>(&pb, &pa, s, &());
+    let z = adaptive_exchange::<f32, _, _, _, 256>(&pa, &pb, Adaptive::new(1e-4), &());
+    println!("gap 1e-6: {x:?} / {y:?} / {z:?}");
+    assert_eq!(x, Err(PdmError::Unresolvable));
+    assert_eq!(y, Err(PdmError::Unresolvable));
+    assert!(z.is_err(), "{z:?}");
+    let (a, b) = plates(1e-3);
+    let (pa, pb) = (Patch::whole(&a).unwrap(), Patch::whole(&b).unwrap());
+    let x = pair_exchange::<f32, _, _, _, 256>(&pa, &pb, s, &()).unwrap();
+    println!("gap 1e-3: {x}");
+    // C-11 algebra at gap 1e-3: 0.37499913 (f64 contour reference); f32 within 1e-5.
+    assert!(rel(f64::from(x), 0.375) < 1e-5, "{x}");
+}
