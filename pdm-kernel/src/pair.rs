@@ -69,11 +69,20 @@ impl PairSettings {
 /// from each point of a), so the two argument orders agree to the quadrature error, not to the
 /// last digit. Divide by A_a ([`Patch::area`]) for F_{a→b}.
 ///
-/// Accuracy at [`PairSettings::ACCURATE`]: about 1e-12 on smooth and touching pairs and on
-/// pairs straddling a back-face cut; across occluders the outer integral converges only
-/// algebraically (a shadow edge meeting the inner patch's corners and edges is a kink of the
-/// outer integrand), about 1e-5 to 1e-4 relative. For a guaranteed accuracy use
-/// [`crate::adaptive_exchange`], whose estimate bounds the error.
+/// Accuracy at [`PairSettings::ACCURATE`]: about 1e-12 on smooth, touching and flat pairs and
+/// on most pairs straddling a back-face cut. Where the outer integrand has a kink or a layer,
+/// the outer rule converges only algebraically, and this fixed-order method has no estimate
+/// of it:
+/// - across occluders (a shadow edge meeting the inner patch's corners and edges): about 1e-5
+///   to 1e-3 relative (a sphere inside a box, floor → the other faces: 4e-4 at order 12);
+/// - curved patches closer than their size to another patch's edge (a sphere cell 0.01 above a
+///   plate's edge region: 1e-4 to 1e-5 at orders 12 to 16; equal coaxial disks 0.01 apart out
+///   of a radius of 5: 1e-3);
+/// - the same curved concave patch twice (the self rule converges like p^−1.3: a thin
+///   cylinder wall's self pair 1e-2 off at order 12; split the surface into a finer grid).
+///
+/// For a guaranteed accuracy use [`crate::adaptive_exchange`], whose estimate bounds the
+/// error and whose `converged` flag says whether the tolerance was met.
 ///
 /// Orientation: each patch radiates to the side its normal ∂g/∂t × ∂g/∂s points to (a
 /// surface's `Side`, or [`crate::Flipped`]). `Ok(0.0)` means no segment between the two
