@@ -365,3 +365,23 @@ fn f32_facing_plates_below_the_resolution() {
     // C-11 algebra at gap 1e-3: 0.37499913 (f64 contour reference); f32 within 1e-5.
     assert!(rel(f64::from(x), 0.375) < 1e-5, "{x}");
 }
+
+/// A value exactly at the physical bound: the whole inner sphere (r = ½) radiates only to the
+/// concentric outer sphere's inside (R = 1.3), F = 1, A·F = A_inner = min(A_a, A_b). At order
+/// 12 the quadrature overshot the bound by ≈ 1e-6 and `pair_exchange` returned
+/// `Err(InvalidResult)`; an overshoot within 1e-4 is quadrature error and the bound is
+/// returned.
+#[test]
+fn concentric_spheres_value_at_the_bound() {
+    let inner = Sphere::<f64>::outer(v([0.0, 0.0, 0.0]), 0.5).unwrap();
+    let outer = Sphere::<f64>::inner(v([0.0, 0.0, 0.0]), 1.3).unwrap();
+    let (a, b) = (Patch::whole(&inner).unwrap(), Patch::whole(&outer).unwrap());
+    let exact = core::f64::consts::PI; // 4π·0.5²·F, F = 1
+    for order in [12, 16] {
+        let ab = pair_exchange::<f64, _, _, _, 1024>(&a, &b, accurate(order), &()).unwrap();
+        let ba = pair_exchange::<f64, _, _, _, 1024>(&b, &a, accurate(order), &()).unwrap();
+        println!("order {order}: {:.1e} / reversed {:.1e}", rel(ab, exact), rel(ba, exact));
+        assert!(ab <= exact && ba <= exact, "{ab} / {ba} above A_inner = {exact}");
+        assert!(rel(ab, exact) < 1e-5 && rel(ba, exact) < 1e-5, "order {order}: {ab} / {ba}");
+    }
+}

@@ -1,0 +1,330 @@
+//! Regression tests for the red-team findings on general geometry (F1–F13): values returned
+//! wrong as `Ok`, refusals of well-posed pairs, and error estimates below the actual error.
+//! Each case computes through the public API (`pair_exchange`, `adaptive_exchange`) and compares
+//! with an exact reference written independently of the kernel: catalogue closed forms from
+//! `pdm_host::reference::closed_form` (Howell C-11, C-14, C-41, the Van Oosterom–Strackee
+//! polygon solid angle), configuration-factor algebra on them (superposition along a common
+//! line, additivity), and sum rules in enclosures. Every test prints all its numbers before it
+//! asserts.
+
+use core::f64::consts::PI;
+use pdm_host::reference::closed_form as exact;
+use pdm_kernel::{
+    adaptive_exchange, pair_exchange, vec3, Adaptive, AutoNormal, Cone, Cylinder, Disk, Frame, Occluder, PairSettings,
+    Parallelogram, ParamRect, ParametricMap, Patch, PdmError, Real, Scalar, Side, Sphere, Surface, Vec3,
+};
+
+fn v<T: Real>(p: [f64; 3]) -> Vec3<T> {
+    vec3(T::from_f64(p[0]), T::from_f64(p[1]), T::from_f64(p[2]))
+}
+
+/// Relative error of a result; infinite for a refusal (so that `< limit` fails).
+fn rel(got: &Result<f64, PdmError>, reference: f64) -> f64 {
+    got.as_ref().map_or(f64::INFINITY, |x| ((x - reference) / reference).abs())
+}
+
+/// A result for printing: the value to 16 digits, or the refusal.
+fn show(got: &Result<f64, PdmError>) -> String {
+    got.as_ref().map_or_else(|e| format!("Err({e})"), |x| format!("{x:.15e}"))
+}
+
+/// Gauss order `order` for separate pairs, 12 for touching pairs, visibility boundaries placed.
+fn settings(order: usize) -> PairSettings {
+    PairSettings { order, singular_order: 12, boundaries: true }
+}
+
+fn square<T: Real>(o: [f64; 3], et: [f64; 3], es: [f64; 3]) -> Parallelogram<T> {
+    Parallelogram::new(v(o), v(et), v(es)).unwrap()
+}
+
+/// A_a·F_{a→b} by `pair_exchange`, as f64.
+fn exchange<T: Real, SA: Surface<T>, SB: Surface<T>, O: Occluder<T>>(
+    a: &Patch<'_, T, SA>,
+    b: &Patch<'_, T, SB>,
+    s: PairSettings,
+    occluders: &O,
+) -> Result<f64, PdmError> {
+    pair_exchange::<T, _, _, _, 1024>(a, b, s, occluders).map(Real::to_f64)
+}
+
+/// A_a·F_{a→b} and A_b·F_{b→a} of two whole surfaces, printed against `reference`.
+fn both_orders<T: Real, SA: Surface<T>, SB: Surface<T>>(
+    a: &SA,
+    b: &SB,
+    s: PairSettings,
+    reference: f64,
+) -> (Result<f64, PdmError>, Result<f64, PdmError>) {
+    let (pa, pb) = (Patch::whole(a).unwrap(), Patch::whole(b).unwrap());
+    let (ab, ba) = (exchange(&pa, &pb, s, &()), exchange(&pb, &pa, s, &()));
+    println!("pair_exchange (order {}): {} / reversed {}, exact {reference:.15e}", s.order, show(&ab), show(&ba));
+    println!("  relative errors {:.2e} / {:.2e}", rel(&ab, reference), rel(&ba, reference));
+    (ab, ba)
+}
+
+/// Σ pair_exchange (a's cells → b's cells) over an m × n grid on a and a p × q grid on b; the
+/// first refusal if any.
+fn grid_sum<T: Real, SA: Surface<T>, SB: Surface<T>>(
+    a: &SA,
+    (m, n): (usize, usize),
+    b: &SB,
+    (p, q): (usize, usize),
+    s: PairSettings,
+) -> Result<f64, PdmError> {
+    let mut sum = 0.0;
+    for pa in Patch::whole(a).unwrap().grid(m, n).unwrap() {
+        for pb in Patch::whole(b).unwrap().grid(p, q).unwrap() {
+            sum += exchange(&pa, &pb, s, &())?;
+        }
+    }
+    Ok(sum)
+}
+
+/// The tolerance mode (max order 12, max depth `depth`, `CAP` 256) on two whole surfaces,
+/// printed against `reference`: (value, estimate, actual error), or the refusal.
+fn adaptive_against<T: Real, SA: Surface<T>, SB: Surface<T>>(
+    a: &SA,
+    b: &SB,
+    (tolerance, depth): (f64, u32),
+    reference: f64,
+) -> Result<(f64, f64, f64), PdmError> {
+    let (pa, pb) = (Patch::whole(a).unwrap(), Patch::whole(b).unwrap());
+    let settings = Adaptive { tolerance: T::from_f64(tolerance), max_order: 12, max_depth: depth };
+    let result = adaptive_exchange::<T, _, _, _, 256>(&pa, &pb, settings, &());
+    match &result {
+        Ok(e) => println!(
+            "adaptive (tol {tolerance:e}, depth {depth}): {:.15e}: error {:.2e}, estimate {:.2e}, converged {}",
+            e.value.to_f64(),
+            (e.value.to_f64() - reference).abs(),
+            e.error.to_f64(),
+            e.converged
+        ),
+        Err(e) => println!("adaptive (tol {tolerance:e}, depth {depth}): refused: {e}"),
+    }
+    result.map(|e| (e.value.to_f64(), e.error.to_f64(), (e.value.to_f64() - reference).abs()))
+}
+
+/// The tolerance mode's result is `Ok` with an estimate that bounds the actual error.
+fn assert_bounded(result: Result<(f64, f64, f64), PdmError>) {
+    match result {
+        Ok((_, error, actual)) => {
+            assert!(actual <= error, "adaptive: error {actual:.2e} above the estimate {error:.2e}")
+        }
+        Err(e) => panic!("adaptive_exchange refused: {e}"),
+    }
+}
+
+/// Howell C-14 superposition along the common line: floor x ∈ [0, a] × y ∈ [0, w] (z = 0,
+/// facing +z) and wall x ∈ [0, b] × z ∈ [0, h] (y = 0, facing +y), a ≤ b, sharing x ∈ [0, a].
+/// With E(L) = L·w·C-14(L, w, h) the exchange of the aligned pair of length L, and
+/// X(I, J) = X(J, I) for intervals I, J of the common line (the kernel depends on x₁ − x₂ only
+/// through an even function), E(b) = E(a) + E(b − a) + 2·X([0, a], [a, b]), so
+/// X([0, a], [0, b]) = E(a) + X([0, a], [a, b]) = ½[E(a) + E(b) − E(b − a)].
+fn floor_to_longer_wall(a: f64, b: f64, w: f64, h: f64) -> f64 {
+    let e = |l: f64| if l > 0.0 { l * w * exact::perpendicular_rectangles(l, w, h) } else { 0.0 };
+    0.5 * (e(a) + e(b) - e(b - a))
+}
+
+/// Howell C-11 algebra for parallel rectangles in the planes z = 0 (x ∈ ax, y ∈ ay) and z = c
+/// (x ∈ bx, y ∈ by), any offsets: the kernel depends on x₁ − x₂ and y₁ − y₂ through even
+/// functions, so A₁F₁₂ = ¼ Σᵢ Σⱼ cᵢ cⱼ f(|dxᵢ|, |dyⱼ|) with d = (a₁ − b₁, a₁ − b₀, a₀ − b₁,
+/// a₀ − b₀), c = (+1, −1, −1, +1), and f(L, M) = L·M·C-11(L, M, c) the exchange of the
+/// directly opposed L × M pair (Siegel & Howell, configuration-factor algebra).
+fn parallel_offset(ax: [f64; 2], ay: [f64; 2], bx: [f64; 2], by: [f64; 2], c: f64) -> f64 {
+    let diffs =
+        |a: [f64; 2], b: [f64; 2]| [(a[1] - b[1], 1.0), (a[1] - b[0], -1.0), (a[0] - b[1], -1.0), (a[0] - b[0], 1.0)];
+    let f = |l: f64, m: f64| if l == 0.0 || m == 0.0 { 0.0 } else { l * m * exact::parallel_rectangles(l, m, c) };
+    let mut sum = 0.0;
+    for (dx, cx) in diffs(ax, bx) {
+        for (dy, cy) in diffs(ay, by) {
+            sum += cx * cy * f(dx.abs(), dy.abs());
+        }
+    }
+    0.25 * sum
+}
+
+/// F1: a whole disk r = 2 and a whole coaxial disk r = 0.5 at 0.05 facing it (the small disk
+/// sees the large one at grazing distance; once `Err(InvalidResult)` from `pair_exchange` at
+/// order 12 and from the tolerance mode, 6.3e-2 off at order 16, large disk outside).
+/// Reference: C-41, A·F = π·2²·C-41(2, 0.5, 0.05). The refusals were the dispatch, not the
+/// order; order 10 and the tolerance mode at depth 0 keep the test under 20 s (order 16 costs
+/// ~12 s per argument order, the tolerance mode's order sequence ~12 s and each subdivision
+/// level ~20 s more).
+#[test]
+fn f1_small_disk_close_over_a_large_disk() {
+    let big = Disk::<f64>::new(v([0.0, 0.0, 0.0]), v([0.0, 0.0, 1.0]), 2.0).unwrap();
+    let small = Disk::<f64>::new(v([0.0, 0.0, 0.05]), v([0.0, 0.0, -1.0]), 0.5).unwrap();
+    let reference = PI * 4.0 * exact::coaxial_disks(2.0, 0.5, 0.05);
+    assert!((reference - 0.7848749366776595).abs() < 1e-15, "{reference}");
+    let (ab, ba) = both_orders(&big, &small, settings(10), reference);
+    let adaptive = adaptive_against(&big, &small, (1e-6, 0), reference);
+    assert!(rel(&ab, reference) < 1e-9 && rel(&ba, reference) < 1e-9, "{ab:?} / {ba:?} vs {reference}");
+    assert_bounded(adaptive);
+}
+
+/// F2: equal whole disks r = 5 at a gap of 0.01 (once 1.0e-3 off in both argument orders at
+/// orders 12 and 16, and `Err(Degenerate)` from the tolerance mode). Reference: C-41,
+/// A·F = 25π·C-41(5, 5, 0.01). The error is the same at orders 8 to 16; order 10 keeps the
+/// test under 20 s (order 16 costs ~22 s per argument order). The tolerance mode's refusal
+/// came from its subdivision (depth ≥ 3), so it runs at its default depth 6.
+#[test]
+#[ignore = "open: whole disks r = 5 at gap 0.01: pair_exchange 1.57e-3 off in both orders at order 10 (78.5059 vs 78.3829; 1.40e-3 at 12, 1.01e-3 at 16), tolerance mode Err(Degenerate)"]
+fn f2_large_disks_at_a_small_gap() {
+    let lower = Disk::<f64>::new(v([0.0, 0.0, 0.0]), v([0.0, 0.0, 1.0]), 5.0).unwrap();
+    let upper = Disk::<f64>::new(v([0.0, 0.0, 0.01]), v([0.0, 0.0, -1.0]), 5.0).unwrap();
+    let reference = 25.0 * PI * exact::coaxial_disks(5.0, 5.0, 0.01);
+    let (ab, ba) = both_orders(&lower, &upper, settings(10), reference);
+    let adaptive = adaptive_against(&lower, &upper, (1e-6, 6), reference);
+    assert!(rel(&ab, reference) < 1e-6 && rel(&ba, reference) < 1e-6, "{ab:?} / {ba:?} vs {reference}");
+    assert_bounded(adaptive);
+}
+
+/// F3: a floor 1/3 × 1/2 against a wall 1 × 0.35 whose bottom edge contains the floor's edge,
+/// the two sharing one endpoint (a partial shared edge). Reference: C-14 superposition
+/// ([`floor_to_longer_wall`]), 3.219835522191568e-2.
+#[test]
+fn f3_partial_shared_edge_with_a_common_endpoint() {
+    let floor = square::<f64>([0.0, 0.0, 0.0], [1.0 / 3.0, 0.0, 0.0], [0.0, 0.5, 0.0]);
+    let wall = square::<f64>([0.0, 0.0, 0.0], [0.0, 0.0, 0.35], [1.0, 0.0, 0.0]);
+    let reference = floor_to_longer_wall(1.0 / 3.0, 1.0, 0.5, 0.35);
+    println!("C-14 superposition: {reference:.16e}");
+    assert!((reference / 3.219835522191568e-2 - 1.0).abs() < 1e-14, "{reference}");
+    let (ab, ba) = both_orders(&floor, &wall, settings(16), reference);
+    let adaptive = adaptive_against(&floor, &wall, (1e-8, 6), reference);
+    assert!(rel(&ab, reference) < 1e-9 && rel(&ba, reference) < 1e-9, "{ab:?} / {ba:?} vs {reference}");
+    assert_bounded(adaptive);
+}
+
+/// F5: a unit sphere whose poles point along (1, 1, 0), cut 4 × 8, over an off-centre plate
+/// 0.01 below it (no occluder: the sphere is convex). Reference: sphere → polygon,
+/// F = Ω/(4π) with Ω the plate's solid angle at the centre (Van Oosterom–Strackee), so
+/// A·F = 4π·Ω/(4π) = Ω. Once 2.0e-4 off at order 16.
+#[test]
+#[ignore = "open: tilted unit sphere 4 x 8 over a plate 0.01 below: sum of pair_exchange 1.35e-5 off at order 16 (1.2323532 vs 1.2323367)"]
+fn f5_tilted_sphere_cells_over_an_off_centre_plate() {
+    let frame = Frame::from_axis(v([1.0, 1.0, 0.0])).unwrap();
+    let sphere = Sphere::<f64>::with_frame(v([0.0; 3]), 1.0, frame, Side::Outer).unwrap();
+    let plate = square::<f64>([0.2, -0.7, -1.01], [2.3, 0.0, 0.0], [0.0, 2.6, 0.0]);
+    let poly = [[0.2, -0.7, -1.01], [2.5, -0.7, -1.01], [2.5, 1.9, -1.01], [0.2, 1.9, -1.01]];
+    let reference = 4.0 * PI * exact::sphere_to_polygon([0.0; 3], &poly);
+    let got = grid_sum(&sphere, (4, 8), &plate, (1, 1), settings(16));
+    println!("sphere 4x8 -> plate: {} vs {reference:.15e}: {:.2e}", show(&got), rel(&got, reference));
+    assert!(rel(&got, reference) < 1e-6, "{got:?} vs {reference}: {:.2e}", rel(&got, reference));
+}
+
+/// F6: the base disk (cut 1 × 4) of a closed cylinder r = 1, h = 0.1 → its inner wall (cut
+/// 4 × 2). Reference: the enclosure sum rule, F_base→wall = 1 − F_base→top with C-41:
+/// A·F = π(1 − C-41(1, 1, 0.1)). Once 6.8e-6 off at order 16.
+#[test]
+fn f6_disk_cells_to_a_short_cylinder_wall() {
+    let base = Disk::<f64>::new(v([0.0, 0.0, 0.0]), v([0.0, 0.0, 1.0]), 1.0).unwrap();
+    let wall = Cylinder::<f64>::new(v([0.0, 0.0, 0.0]), v([0.0, 0.0, 1.0]), 1.0, 0.1, Side::Inner).unwrap();
+    let reference = PI * (1.0 - exact::coaxial_disks(1.0, 1.0, 0.1));
+    let got = grid_sum(&base, (1, 4), &wall, (4, 2), settings(16));
+    println!("base 1x4 -> wall 4x2: {} vs {reference:.15e}: {:.2e}", show(&got), rel(&got, reference));
+    assert!(rel(&got, reference) < 1e-8, "{got:?} vs {reference}: {:.2e}", rel(&got, reference));
+}
+
+/// F13 (f32): a unit square and a unit square 1e-6 above it, offset by (0.5, 0.25): the
+/// exchange is about the overlap area 0.375. Once 1.3e-2 off as `Ok`. A refusal is
+/// acceptable; a value must be right to 1e-4, and the tolerance mode's estimate must bound its
+/// error. Reference: C-11 algebra in f64 ([`parallel_offset`]).
+#[test]
+fn f13_f32_offset_squares_almost_touching() {
+    let gap = f64::from(1e-6f32);
+    let lower = square::<f32>([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]);
+    let upper = square::<f32>([0.5, 0.25, gap], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]);
+    let reference = parallel_offset([0.0, 1.0], [0.0, 1.0], [0.5, 1.5], [0.25, 1.25], gap);
+    println!("C-11 algebra: {reference:.15e} (overlap area 0.375)");
+    assert!((reference - 0.375).abs() < 1e-5, "{reference}");
+    let (ab, ba) = both_orders(&lower, &upper, settings(16), reference);
+    let adaptive = adaptive_against(&lower, &upper, (1e-4, 6), reference);
+    for (name, got) in [("lower -> upper", &ab), ("upper -> lower", &ba)] {
+        assert!(got.is_err() || rel(got, reference) < 1e-4, "{name}: {got:?} vs {reference}");
+    }
+    if let Ok((_, error, actual)) = adaptive {
+        assert!(actual <= error, "adaptive: error {actual:.2e} above the estimate {error:.2e}");
+    }
+}
+
+/// F12: a whole disk r = 0.5 closing the inside of a cone r = 0.5, height 3 (apex over the
+/// centre). The base is flat (F_base→base = 0), so the enclosure sum rule gives
+/// F_base→cone = 1: A·F = π/4. The tolerance mode once refused it (`Err(InvalidResult)`).
+#[test]
+fn f12_disk_closing_a_tall_cone() {
+    let base = Disk::<f64>::new(v([0.0, 0.0, 0.0]), v([0.0, 0.0, 1.0]), 0.5).unwrap();
+    let cone = Cone::<f64>::new(v([0.0, 0.0, 0.0]), v([0.0, 0.0, 1.0]), 0.5, 0.0, 3.0, Side::Inner).unwrap();
+    let reference = PI * 0.25;
+    let (ab, ba) = both_orders(&base, &cone, settings(16), reference);
+    let adaptive = adaptive_against(&base, &cone, (1e-6, 6), reference);
+    assert!(rel(&ab, reference) < 1e-9 && rel(&ba, reference) < 1e-9, "{ab:?} / {ba:?} vs {reference}");
+    assert_bounded(adaptive);
+}
+
+/// The unit square [0, 1]² in z = 0 with a non-uniform parameterisation:
+/// g(t, s) = (t + 0.3/(2π)·sin 2πt, ½s² + ½s, 0), both components increasing, normal +z.
+struct WarpedSquare;
+
+impl ParametricMap<f64> for WarpedSquare {
+    fn domain(&self) -> ParamRect<f64> {
+        ParamRect { t0: 0.0, t1: 1.0, s0: 0.0, s1: 1.0 }
+    }
+    fn map<S: Scalar<f64>>(&self, t: S, s: S) -> Vec3<S> {
+        let k = S::constant(0.3 / (2.0 * PI));
+        let x = t + k * (S::constant(2.0 * PI) * t).sin();
+        let half = S::constant(0.5);
+        let y = half * s * s + half * s;
+        vec3(x, y, S::constant(0.0))
+    }
+}
+
+/// F4: the warped user-map unit square → the perpendicular unit square sharing its edge y = 0.
+/// Reference: C-14 for unit squares. Once 1.1e-5 off at order 16 with the user map outside,
+/// and the tolerance mode's estimate below its error.
+#[test]
+fn f4_user_map_square_sharing_an_edge() {
+    let warped = AutoNormal(WarpedSquare);
+    let wall = square::<f64>([0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]);
+    let reference = exact::perpendicular_rectangles(1.0, 1.0, 1.0);
+    let (ab, ba) = both_orders(&warped, &wall, settings(16), reference);
+    let adaptive = adaptive_against(&warped, &wall, (1e-8, 6), reference);
+    assert!(rel(&ab, reference) < 1e-8 && rel(&ba, reference) < 1e-8, "{ab:?} / {ba:?} vs {reference}");
+    assert_bounded(adaptive);
+}
+
+/// F10: a box [0, 2] × [0, 1.5] × [0, 1] (faces radiating inward) with a sphere R = 0.3 at
+/// (0.7, 0.6, 0.45) as occluder: the floor → the five other faces. Reference: the floor's row
+/// sum, Σⱼ A_f·F_f→j = A_f − A_f·F_f→sphere (F_f→f = 0, A_f = 3), and by reciprocity
+/// A_f·F_f→sphere = A_s·F_sphere→f = 4πR²·Ω_f/(4π) = R²·Ω_f with Ω_f the floor's solid angle
+/// at the sphere's centre (Van Oosterom–Strackee; nothing stands between the sphere and the
+/// floor). A Monte Carlo check of F_floor→sphere (4e8 cosine-weighted rays from the floor)
+/// gave 0.1036118 ± 1.5e-5 against 0.1036194 from this formula. Once 4.1e-4 off.
+#[test]
+#[ignore = "open: box floor row with a sphere occluder: 2.6880477 vs 2.6891419, 4.07e-4 off at order 16 (floor -> sphere 0.10398 vs 0.10362)"]
+fn f10_box_floor_row_with_a_sphere_inside() {
+    let (centre, radius) = ([0.7, 0.6, 0.45], 0.3);
+    let sphere = Sphere::<f64>::outer(v(centre), radius).unwrap();
+    let floor = square::<f64>([0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 1.5, 0.0]);
+    let others = [
+        ("ceiling", square::<f64>([0.0, 0.0, 1.0], [0.0, 1.5, 0.0], [2.0, 0.0, 0.0])),
+        ("x = 0", square::<f64>([0.0, 0.0, 0.0], [0.0, 1.5, 0.0], [0.0, 0.0, 1.0])),
+        ("x = 2", square::<f64>([2.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.5, 0.0])),
+        ("y = 0", square::<f64>([0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [2.0, 0.0, 0.0])),
+        ("y = 1.5", square::<f64>([0.0, 1.5, 0.0], [2.0, 0.0, 0.0], [0.0, 0.0, 1.0])),
+    ];
+    let floor_poly = [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [2.0, 1.5, 0.0], [0.0, 1.5, 0.0]];
+    let to_sphere = radius * radius * exact::polygon_solid_angle(centre, &floor_poly);
+    let reference = 3.0 - to_sphere;
+    let pf = Patch::whole(&floor).unwrap();
+    let mut total = Ok(0.0);
+    for (name, face) in &others {
+        let x = exchange(&pf, &Patch::whole(face).unwrap(), settings(16), &sphere);
+        println!("floor -> {name}: {}", show(&x));
+        total = total.and_then(|t| x.map(|x| t + x));
+    }
+    println!(
+        "row sum {} vs {reference:.15e} (floor -> sphere {to_sphere:.15e}): {:.2e}",
+        show(&total),
+        rel(&total, reference)
+    );
+    assert!(rel(&total, reference) < 1e-5, "{total:?} vs {reference}: {:.2e}", rel(&total, reference));
+}
