@@ -58,7 +58,7 @@ where
     T: Real,
     O: Occluder<T> + ?Sized,
 {
-    crate::bounds::exchange(exchange_unchecked(a, b, occluders)?, a.area(), b.area())
+    crate::bounds::exchange(exchange_sum(a, b, occluders), a.area(), b.area())
 }
 
 /// [`exchange`] without the bounds check (finite only): a part of a larger sum, or one of the
@@ -72,12 +72,26 @@ where
     T: Real,
     O: Occluder<T> + ?Sized,
 {
+    crate::bounds::finite(exchange_sum(a, b, occluders))
+}
+
+/// The eq. 16 sum of [`exchange`] times 1/π, unchecked (the bounds check also rejects NaN).
+#[inline(always)]
+fn exchange_sum<T, O, const CA: usize, const CB: usize>(
+    a: &PatchSamples<T, CA>,
+    b: &PatchSamples<T, CB>,
+    occluders: &O,
+) -> T
+where
+    T: Real,
+    O: Occluder<T> + ?Sized,
+{
     let sum = if occluders.may_block_between(&a.bounds(), &b.bounds()) {
         pdm_sum(a, b, Some(occluders))
     } else {
         pdm_sum::<T, O, CA, CB>(a, b, None)
     };
-    crate::bounds::finite(sum * T::FRAC_1_PI)
+    sum * T::FRAC_1_PI
 }
 
 /// F_{a→b} between two sampled patches by eqs. (15)–(16) with the 1/π and Jacobians restored,
