@@ -292,9 +292,8 @@ where
     Some(Ok(Estimate::leaf(hi, difference, settings.tolerance, n_lo.saturating_add(n_hi))))
 }
 
-/// Whether the Gauss rules of order `order` resolve the pair: its closest sample points are at
-/// least [`crate::form_factor::RESOLVED_DISTANCE`] node spacings apart (a spacing: the
-/// patch's sample-ball diameter / order), so the kernel varies over several nodes of each rule.
+/// Whether the Gauss rules of order `order` resolve the pair
+/// ([`crate::form_factor::samples_resolved`]).
 #[inline(never)]
 fn resolved<T, SA, SB, const CAP: usize>(
     a: &Patch<'_, T, SA>,
@@ -308,16 +307,7 @@ where
 {
     let sa = PatchSamples::<T, CAP>::new(a, order)?;
     let sb = PatchSamples::<T, CAP>::new(b, order)?;
-    let spacing = |s: &PatchSamples<T, CAP>| s.bounds().radius * T::TWO / T::from_usize(order);
-    let limit = spacing(&sa).max(spacing(&sb)) * T::from_usize(crate::form_factor::RESOLVED_DISTANCE);
-    let limit2 = limit * limit;
-    let close = sa.iter().any(|p| {
-        sb.iter().any(|q| {
-            let e = q.point - p.point;
-            e.dot(e) < limit2
-        })
-    });
-    Ok(!close)
+    Ok(crate::form_factor::samples_resolved(&sa, order, &sb, order))
 }
 
 /// The same patch twice by the self rule ([`crate::self_form_factor`], orders p and p + 1 with

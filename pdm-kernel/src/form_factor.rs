@@ -25,7 +25,7 @@ use crate::error::PdmError;
 use crate::gauss::GaussRule;
 use crate::patch::{Patch, PatchGrid};
 use crate::real::Real;
-use crate::samples::PatchSamples;
+use crate::samples::{Ball, PatchSamples};
 use crate::surface::Surface;
 use crate::visibility::Occluder;
 
@@ -210,11 +210,27 @@ where
     if crate::singular::classify_near(a, b).0 != crate::singular::Adjacency::Separate {
         return Ok((None, sa.area()));
     }
-    let spacing = |s: &PatchSamples<T, CAP>, order: usize| s.bounds().radius * T::TWO / T::from_usize(order.max(1));
-    let limit = spacing(&sa, rule_a.order()).max(spacing(&sb, rule_b.order())) * T::from_usize(RESOLVED_DISTANCE);
+    if !samples_resolved(&sa, rule_a.order(), &sb, rule_b.order()) {
+        return Ok((None, sa.area()));
+    }
+    Ok((Some(exchange(&sa, &sb, occluders)?), sa.area()))
+}
+
+/// Whether Gauss rules of orders `order_a`, `order_b` resolve the pair sampled as `sa`, `sb`:
+/// its closest sample points are at least [`RESOLVED_DISTANCE`] node spacings apart (a
+/// spacing: a patch's sample-ball diameter / its order), so the kernel varies over several
+/// nodes of each rule.
+pub(crate) fn samples_resolved<T: Real, const CA: usize, const CB: usize>(
+    sa: &PatchSamples<T, CA>,
+    order_a: usize,
+    sb: &PatchSamples<T, CB>,
+    order_b: usize,
+) -> bool {
+    let spacing = |ball: Ball<T>, order: usize| ball.radius * T::TWO / T::from_usize(order.max(1));
+    let (ba, bb) = (sa.bounds(), sb.bounds());
+    let limit = spacing(ba, order_a).max(spacing(bb, order_b)) * T::from_usize(RESOLVED_DISTANCE);
     let limit2 = limit * limit;
     // The sample balls' gap bounds every sample distance from below: far pairs skip the scan.
-    let (ba, bb) = (sa.bounds(), sb.bounds());
     let close = (ba.center - bb.center).norm() - ba.radius - bb.radius < limit
         && sa.iter().any(|p| {
             sb.iter().any(|q| {
@@ -222,10 +238,7 @@ where
                 e.dot(e) < limit2
             })
         });
-    if close {
-        return Ok((None, sa.area()));
-    }
-    Ok((Some(exchange(&sa, &sb, occluders)?), sa.area()))
+    !close
 }
 
 /// F_{a→a}: the fraction of a concave patch's radiation that falls on the patch itself
