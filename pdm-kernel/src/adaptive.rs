@@ -6,7 +6,7 @@
 //!    contour form at two orders (where its terms cancel beyond the working precision, the
 //!    paths below take the pair if their rules resolve it, else `Err(Unresolvable)`);
 //!    touching pairs use the regularising transforms, raising the order by 2 from 4; the same
-//!    patch twice uses [`self_form_factor`](crate::self_form_factor) (see below);
+//!    patch twice uses the identical-panel transform (see below);
 //! 2. for separate pairs, starts from an order chosen from the geometry — the Gauss error on an
 //!    integrand whose nearest singularity lies at distance d from patches of size h falls like
 //!    ρ^(−2p) with ρ ≈ 1 + 2d/h, so p₀ = ⌈ln(1/tol) / (2 ln ρ)⌉ (clamped to 2…12);
@@ -54,18 +54,15 @@
 //!   walls inside a coaxial tube; references in closed form up to a 1-D integral): the
 //!   largest |actual error| / difference was 1.01 outside the rounding level (the earlier
 //!   estimate, the split at p against the whole at p and p + 1, reached 3.0).
-//! * The same patch twice ([`Adjacency::Identical`]): the plain self rule converges only
-//!   algebraically (the kernel has a kink on the diagonal of a curved patch: measured ∝ p^−1.3
-//!   on a tube's inside; an occluder adds jumps, and the error then oscillates in sign from
-//!   order to order inside an envelope ∝ 1/p: 1e-2…6e-2 at p = 11 for a tube wall around a
-//!   coaxial tube), so the estimate is 2 × the largest difference between the highest order
-//!   and orders p − 1, p − 2, p − 3 and p/2 (p = `max_order` − 1; measured for p = 7…31 on
-//!   five tube-wall patches with and without the coaxial tube: actual / estimate ≤ 0.88, at
-//!   p = 8 on an unoccluded quarter wall). The pair is not subdivided: splitting it 2 × 2 gives
-//!   four self pairs and twelve touching pairs on a curved patch, and measured on the inside
-//!   of three quarters of a tube that cost 7e8 evaluations (8 minutes) at tolerance 1e-2. A
-//!   self pair above the tolerance is returned with `converged = false`; a finer patch grid
-//!   or a higher `max_order` (the error falls ∝ p^−1.3 without occluders) is the remedy.
+//! * The same patch twice ([`Adjacency::Identical`]) by the identical-panel transform
+//!   ([`crate::singular`]): without an occluder that may cut the patch's view of itself, as a
+//!   touching pair (orders 4, 6, …, both copies split 2 × 2 at `max_order`; a quarter of a
+//!   tube's inside meets 1e-10 with 2.2e5 evaluations). With one, the shadow makes the
+//!   integrand jump and the convergence algebraic: the value at p = `max_order` with 2 × the
+//!   largest difference from orders p − 1, p − 2, p − 3 and p/2, not split (splitting a self
+//!   pair that an occluder cuts multiplies the touching sub-pairs at every level); above the
+//!   tolerance it says so with `converged = false` (three quarters of a tube's inside around
+//!   a coaxial tube: 2.3e-6 actual against an estimate of 4.8e-4).
 //!
 //! # Settings
 //! `tolerance` must be positive and finite, `max_order` in 8..=[`MAX_ORDER`](crate::MAX_ORDER)
@@ -237,6 +234,10 @@ where
             Some(result) => return result,
         }
     }
+    let touching = adjacency != Adjacency::Separate;
+    if touching && (crate::singular::has_collapsed_side(a) || crate::singular::has_collapsed_side(b)) {
+        return collapsed_contact::<T, SA, SB, O>(a, b, adjacency, gap, settings, occluders);
+    }
     match adjacency {
         Adjacency::SharedEdge { .. } | Adjacency::SharedVertex { .. } => {
             // The transforms test occlusion only at their sample points: with an occluder that
@@ -256,8 +257,7 @@ where
             let eval = |p: usize| Ok((touching_unchecked(a, b, adjacency, gap, p, occluders)?, per_order(p)));
             by_order_doubling::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, eval, 4, Split::Both)
         }
-        // Not split (module docs): the leaf says whether it met the tolerance.
-        Adjacency::Identical => identical::<T, SA, O, CAP>(a, settings, occluders),
+        Adjacency::Identical => identical::<T, SA, O, CAP>(a, settings, occluders, depth),
         Adjacency::Separate => separate::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth),
     }
 }
@@ -310,33 +310,79 @@ where
     Ok(crate::form_factor::samples_resolved(&sa, order, &sb, order))
 }
 
-/// The same patch twice by the self rule ([`crate::self_form_factor`], orders p and p + 1 with
-/// p = `max_order` − 1), estimated against orders p − 1, p − 2, p − 3 and p/2 (module docs).
+/// The same patch twice by the identical-panel transform
+/// ([`identical_unchecked`](crate::singular)). Without an occluder that may cut the patch's
+/// view of itself the kernel is smooth in the transformed variables: orders 4, 6, … as for a
+/// touching pair, splitting both copies 2 × 2 at `max_order`. With one, the shadow makes the
+/// integrand jump and the convergence algebraic: the value at p = `max_order`, estimated as
+/// 2 × the largest difference from orders p − 1, p − 2, p − 3 and p/2 (module docs), not split.
 #[inline(never)]
 fn identical<T, S, O, const CAP: usize>(
     a: &Patch<'_, T, S>,
     settings: Adaptive<T>,
     occluders: &O,
+    depth: u32,
 ) -> Result<Estimate<T>, PdmError>
 where
     T: Real,
     S: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
-    let p = settings.max_order - 1;
-    let self_ff = |order: usize| -> Result<T, PdmError> {
-        let (exchange, area) = crate::form_factor::self_exchange_unchecked::<T, S, O, CAP>(a, order, occluders)?;
-        Ok(exchange / area)
-    };
-    let hi = self_ff(p)?;
-    let lower = [p - 1, p - 2, p - 3, p / 2];
-    let mut difference = T::ZERO;
-    for &q in &lower {
-        difference = difference.max((hi - self_ff(q)?).abs());
+    let ball = a.enclosing_ball();
+    if !occluders.may_block_between(&ball, &ball) {
+        let eval = |p: usize| crate::singular::identical_unchecked(a, p, occluders);
+        return by_order_doubling::<T, S, S, O, CAP>(a, a, settings, occluders, depth, eval, 4, Split::Both);
     }
-    let area = a.area(settings.max_order)?;
-    let evaluations = lower.iter().chain([&p]).map(|&q| ((q * (q + 1)) as u64).pow(2)).sum();
-    Ok(Estimate::leaf(hi * area, T::from_f64(SAFETY) * difference * area, settings.tolerance, evaluations))
+    algebraic_leaf(|p| crate::singular::identical_unchecked(a, p, occluders), settings)
+}
+
+/// A touching or identical pair where a patch has a side collapsed to a point (a cone's apex:
+/// `singular::has_collapsed_side`). The transforms converge only algebraically there, so the
+/// leaf is estimated like an occluded self pair: the value at p = `max_order`, 2 × the largest
+/// difference from orders p − 1, p − 2, p − 3 and p/2 (a rate p^−a is bounded for a ≥ 0.6).
+/// Not split: the cells at the collapsed point stay algebraic at every level.
+#[inline(never)]
+fn collapsed_contact<T, SA, SB, O>(
+    a: &Patch<'_, T, SA>,
+    b: &Patch<'_, T, SB>,
+    adjacency: Adjacency,
+    gap: T,
+    settings: Adaptive<T>,
+    occluders: &O,
+) -> Result<Estimate<T>, PdmError>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
+    let eval = |p: usize| -> Result<(T, u64), PdmError> {
+        match adjacency {
+            Adjacency::Identical => crate::singular::identical_unchecked(a, p, occluders),
+            _ => {
+                let per = if matches!(adjacency, Adjacency::SharedEdge { .. }) { 6 } else { 4 };
+                Ok((touching_unchecked(a, b, adjacency, gap, p, occluders)?, per * (p as u64).pow(4)))
+            }
+        }
+    };
+    algebraic_leaf(eval, settings)
+}
+
+/// The value at p = `max_order` and 2 × the largest difference from orders p − 1, p − 2,
+/// p − 3 and p/2: the estimate of a leaf that converges only algebraically in the order.
+fn algebraic_leaf<T: Real>(
+    eval: impl Fn(usize) -> Result<(T, u64), PdmError>,
+    settings: Adaptive<T>,
+) -> Result<Estimate<T>, PdmError> {
+    let p = settings.max_order;
+    let (hi, mut evaluations) = eval(p)?;
+    let mut difference = T::ZERO;
+    for q in [p - 1, p - 2, p - 3, p / 2] {
+        let (v, n) = eval(q)?;
+        difference = difference.max((hi - v).abs());
+        evaluations = evaluations.saturating_add(n);
+    }
+    Ok(Estimate::leaf(hi, T::from_f64(SAFETY) * difference, settings.tolerance, evaluations))
 }
 
 /// The starting order of a separate pair from its geometry (module docs, item 2), capped at

@@ -177,11 +177,7 @@ where
     if let Some(e) = plain {
         return Ok((e, area));
     }
-    let (adjacency, _) = crate::singular::classify_near(a, b);
-    let mut order = rule_a.order().max(rule_b.order()).max(2);
-    if adjacency == crate::singular::Adjacency::Identical && (order + 1) * (order + 1) > CAP {
-        order -= 1;
-    }
+    let order = rule_a.order().max(rule_b.order()).max(2);
     let settings = crate::pair::PairSettings { order, singular_order: order, boundaries: true };
     Ok((crate::pair::pair_exchange::<T, SA, SB, O, CAP>(a, b, settings, occluders)?, area))
 }
@@ -245,7 +241,10 @@ pub(crate) fn samples_resolved<T: Real, const CA: usize, const CB: usize>(
 /// (section 3.3, F_ii ≠ 0). The two copies of the patch are sampled at orders p and p + 1,
 /// whose Gauss nodes interlace and never coincide, so no sample pair has L = 0. Exact (to the
 /// rule) when the integrand is smooth, e.g. on the inside of a sphere where it is constant;
-/// zero for flat and convex patches. Needs `order + 1 ≤ MAX_ORDER` and `CAP ≥ (order + 1)²`.
+/// zero for flat and convex patches. Elsewhere the kernel's direction-dependent limit on the
+/// diagonal makes it converge only algebraically (≈ p^−1.3 on a tube's inside);
+/// [`crate::pair_exchange`] with the patch twice uses the identical-panel transform instead,
+/// which converges exponentially. Needs `order + 1 ≤ MAX_ORDER` and `CAP ≥ (order + 1)²`.
 pub fn self_form_factor<T, S, O, const CAP: usize>(
     patch: &Patch<'_, T, S>,
     order: usize,

@@ -6,7 +6,8 @@
 //! - Touching pairs (shared edge or vertex, found by [`crate::singular::classify_near`], also
 //!   when they are only nearly touching) use the regularising
 //!   transforms of [`crate::singular`], converging exponentially with `singular_order`.
-//! - The same patch twice uses the interlaced-order self integral ([`crate::self_form_factor`]).
+//! - The same patch twice uses the identical-panel transform of [`crate::singular`],
+//!   converging exponentially with `singular_order` on a smooth patch.
 //! - Two flat patches (parallelograms) that see each other wholly, with no occluder able to cut
 //!   between them and not sharing a whole edge in exact contact, use the contour form
 //!   (`contour.rs`): exact at any gap, from far apart down to nearly coincident, and for a
@@ -82,8 +83,9 @@ impl PairSettings {
 /// - curved patches closer than their size to another patch's edge (a sphere cell 0.01 above a
 ///   plate's edge region: 1e-4 to 1e-5 at orders 12 to 16; equal coaxial disks 0.01 apart out
 ///   of a radius of 5: 1e-3);
-/// - the same curved concave patch twice (the self rule converges like p^−1.3: a thin
-///   cylinder wall's self pair 1e-2 off at order 12; split the surface into a finer grid).
+/// - pairs touching where a patch's side collapses to a point on a concave surface (the
+///   pieces of a cone's inside at its apex: the whole wall against itself 7.5e-3 off at
+///   singular order 12, 3.2e-3 at 16; a frustum, without the apex, 8e-11).
 ///
 /// For a guaranteed accuracy use [`crate::adaptive_exchange`], whose estimate bounds the
 /// error and whose `converged` flag says whether the tolerance was met.
@@ -94,8 +96,7 @@ impl PairSettings {
 /// away from each other, are hidden, or one faces away from the other — a mistaken
 /// orientation gives the same zero as a true one, so check the sides when a zero surprises.
 ///
-/// `CAP` bounds the samples of one patch: ≥ order² (and ≥ (order + 1)² if a and b may be the
-/// same patch). Errors: bad input, `Err(InvalidResult)` for a value outside the physical
+/// `CAP` bounds the samples of one patch: ≥ order². Errors: bad input, `Err(InvalidResult)` for a value outside the physical
 /// bounds by more than 1e-4 of itself (closer, the bound is returned), `Err(Unresolvable)` where the working precision cannot resolve the pair.
 ///
 /// ```
@@ -126,7 +127,7 @@ where
 /// [`pair_exchange`] and the work it did, in integrand evaluations: kernel evaluations and
 /// visibility probes on the boundary path ([`crate::boundary_exchange_counted`]), order⁴ for a
 /// plain sum and order⁴ more for the straddle check, 6·p⁴ for a shared edge and 4·p⁴ for a
-/// shared vertex (p = `singular_order`), (order·(order + 1))² for a self pair.
+/// shared vertex (p = `singular_order`), 4·p⁴ for a self pair (times the ζ-shells of long patches).
 pub fn pair_exchange_counted<T, SA, SB, O, const CAP: usize>(
     a: &Patch<'_, T, SA>,
     b: &Patch<'_, T, SB>,
@@ -260,14 +261,7 @@ where
             let count = if matches!(adjacency, Adjacency::SharedEdge { .. }) { 6 * q4 } else { 4 * q4 };
             Ok((touching_unchecked(a, b, adjacency, gap, settings.singular_order, occluders)?, count))
         }
-        Adjacency::Identical => {
-            let (exchange, area) =
-                crate::form_factor::self_exchange_unchecked::<T, SA, O, CAP>(a, settings.order, occluders)?;
-            let q = (settings.order * (settings.order + 1)) as u64;
-            // The mean area of the rule's two copies keeps the value reciprocal; rescaled to the
-            // area the entry point divides by.
-            Ok((exchange / area * a.area(settings.order)?, q * q))
-        }
+        Adjacency::Identical => crate::singular::identical_unchecked(a, settings.singular_order, occluders),
         Adjacency::Separate => {
             let sa = PatchSamples::<T, CAP>::new(a, settings.order)?;
             let sb = PatchSamples::<T, CAP>::new(b, settings.order)?;
@@ -459,7 +453,7 @@ fn is_flat<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>) -> bool {
 /// lying along a longer one from a common corner, a non-conforming grid), whose line of
 /// contact the vertex transform does not expect (it converges only algebraically there). Two
 /// patches sharing a whole edge in exact contact keep the edge transform; the same patch twice
-/// the self rule.
+/// the identical-panel transform.
 pub(crate) fn contour_applies<T: Real>(adjacency: Adjacency, gap: T) -> bool {
     match adjacency {
         Adjacency::Separate | Adjacency::SharedVertex { .. } => true,

@@ -420,27 +420,24 @@ fn wall_pair_inside_a_tube_around_a_coaxial_tube() {
 
 #[test]
 fn self_pair_inside_a_tube() {
-    // The inside of a tube against itself (the `Identical` path), with and without a coaxial
-    // tube occluding. The plain self rule converges algebraically, and with the occluder its
-    // error oscillates from order to order; the estimate compared orders p and p − 2 only and
-    // was 1.2× below the actual error. Self pairs are not subdivided: above the tolerance
-    // they say so.
+    // The inside of a tube against itself (the `Identical` path: the patch is cut at its seams
+    // into four pieces, each piece against itself by the identical-panel transform), with and
+    // without a coaxial tube occluding. With an occluder that may cut the view, the self pairs
+    // are estimated from five orders (algebraic convergence): the estimate is pessimistic but
+    // must bound the error, and the result says when the tolerance was missed.
     let (outer, inner) = tubes(0.5);
     let t = (0.0, 1.5 * PI);
     let patch = Patch::new(&outer, ParamRect::new(t.0, t.1, 0.0, 1.0).unwrap()).unwrap();
     let reference = cylinder_wall_pair(1.0, 0.5, 1.0, t, t);
-    let e = tolerance_sweep("tube wall self, coaxial tube", &patch, &patch, &inner, reference, &TOLERANCES);
-    assert!(e.iter().all(|e| !e.converged));
+    let e = tolerance_sweep("tube wall self, coaxial tube", &patch, &patch, &inner, reference, &[1e-2, 1e-5]);
+    assert!(e[0].converged && !e[1].converged, "{e:?}");
+    // Without an occluder the transform converges exponentially: every tolerance down to 1e-10
+    // is met (the estimate bounds the error: `check`).
     let t = (0.0, PI / 2.0);
     let quarter = Patch::new(&outer, ParamRect::new(t.0, t.1, 0.0, 1.0).unwrap()).unwrap();
     let reference = cylinder_wall_pair(1.0, 0.0, 1.0, t, t);
-    let e = tolerance_sweep("quarter tube wall self", &quarter, &quarter, &(), reference, &[1e-2, 1e-3]);
-    assert!(e[0].converged && !e[1].converged, "{e:?}");
-    // A higher max_order reaches 1e-3.
-    let high = Adaptive { max_order: 32, ..Adaptive::new(1e-3) };
-    let e = adaptive_exchange::<f64, _, _, _, 1024>(&quarter, &quarter, high, &()).unwrap();
-    check("quarter tube wall self, max order 32", &e, reference, 1e-3, quarter.area(16).unwrap(), 1e-13);
-    assert!(e.converged, "{e:?}");
+    let e = tolerance_sweep("quarter tube wall self", &quarter, &quarter, &(), reference, &[1e-2, 1e-6, 1e-10]);
+    assert!(e.iter().all(|e| e.converged), "{e:?}");
 }
 
 #[test]
