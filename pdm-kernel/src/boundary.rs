@@ -580,7 +580,7 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
     fn integral_split(&self, p: Vec3<T>, np: Vec3<T>, r: ParamRect<T>, depth: u32) -> Result<T, PdmError> {
         match self.integral_over(p, np, r) {
             Err(PdmError::CapacityExceeded { .. }) if depth < MAX_SPLITS => {
-                let (lo, hi) = if depth % 2 == 0 {
+                let (lo, hi) = if depth.is_multiple_of(2) {
                     let m = (r.s0 + r.s1) * T::HALF;
                     (ParamRect { s1: m, ..r }, ParamRect { s0: m, ..r })
                 } else {

@@ -54,7 +54,7 @@ pub fn kernel_need<T>(cap: usize) -> usize {
 }
 
 /// The stack every thread that runs kernel work at capacity `cap` gets: twice
-/// [`kernel_need`] plus [`HOST_FRAMES`], rounded up to a MiB.
+/// [`kernel_need`] plus 1 MiB for the host's own frames, rounded up to a MiB.
 #[must_use]
 pub fn thread_stack<T: Real>(cap: usize) -> usize {
     let bytes = 2 * kernel_need::<T>(cap) + HOST_FRAMES;
