@@ -64,6 +64,10 @@
 //!   tolerance it says so with `converged = false` (three quarters of a tube's inside around
 //!   a coaxial tube: 2.3e-6 actual against an estimate of 4.8e-4).
 //!
+//! * Self and edge pairs whose contact reaches a side collapsed to a point (a cone's apex)
+//!   converge only algebraically ([`crate::singular`]): the same five-order estimate as an
+//!   occluded self pair, not split (the cells at the apex stay algebraic at every level).
+//!
 //! # Settings
 //! `tolerance` must be positive and finite, `max_order` in 8..=[`MAX_ORDER`](crate::MAX_ORDER)
 //! and `max_depth` ≤ [`MAX_DEPTH`]; anything else is `Err(InvalidSetting)`, checked before any
@@ -234,8 +238,7 @@ where
             Some(result) => return result,
         }
     }
-    let touching = adjacency != Adjacency::Separate;
-    if touching && (crate::singular::has_collapsed_side(a) || crate::singular::has_collapsed_side(b)) {
+    if crate::singular::contact_reaches_collapsed_side(a, b, adjacency) {
         return collapsed_contact::<T, SA, SB, O>(a, b, adjacency, gap, settings, occluders);
     }
     match adjacency {
@@ -336,8 +339,9 @@ where
     algebraic_leaf(|p| crate::singular::identical_unchecked(a, p, occluders), settings)
 }
 
-/// A touching or identical pair where a patch has a side collapsed to a point (a cone's apex:
-/// `singular::has_collapsed_side`). The transforms converge only algebraically there, so the
+/// A self or edge pair whose contact reaches a side collapsed to a point (a cone's apex:
+/// `singular::contact_reaches_collapsed_side`). The transforms converge only algebraically
+/// there, so the
 /// leaf is estimated like an occluded self pair: the value at p = `max_order`, 2 × the largest
 /// difference from orders p − 1, p − 2, p − 3 and p/2 (a rate p^−a is bounded for a ≥ 0.6).
 /// Not split: the cells at the collapsed point stay algebraic at every level.

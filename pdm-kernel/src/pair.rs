@@ -83,9 +83,9 @@ impl PairSettings {
 /// - curved patches closer than their size to another patch's edge (a sphere cell 0.01 above a
 ///   plate's edge region: 1e-4 to 1e-5 at orders 12 to 16; equal coaxial disks 0.01 apart out
 ///   of a radius of 5: 1e-3);
-/// - pairs touching where a patch's side collapses to a point on a concave surface (the
-///   pieces of a cone's inside at its apex: the whole wall against itself 7.5e-3 off at
-///   singular order 12, 3.2e-3 at 16; a frustum, without the apex, 8e-11).
+/// - self and edge pairs reaching a side that collapses to a point on a concave surface (the
+///   pieces of a cone's inside at its apex: the whole wall against itself 2.0e-5 off at
+///   singular order 12, 6.6e-6 at 16; a frustum, without the apex, 8e-11).
 ///
 /// For a guaranteed accuracy use [`crate::adaptive_exchange`], whose estimate bounds the
 /// error and whose `converged` flag says whether the tolerance was met.

@@ -50,6 +50,16 @@
 //! tube wall's self pair, 1.6e-2 off at order 12 by the plain self rule, is 2.2e-8 off (and
 //! 2e-10 at order 16). Long patches get ζ-shells beyond the shorter side as above.
 //!
+//! **A side collapsed to a point.** A cone's apex, a disk's centre or a sphere's pole is a whole
+//! side of the patches that meet there (the parameterisation collapses). Two patches touching
+//! only at such a vertex are singular where both their radial variables vanish, for every value
+//! of the variables along the collapsed sides: the pyramids then run over the radial variables
+//! only (ζ^(k−1) for k of them) and the variables along the collapsed sides get the plain rule
+//! (`collapsed_vertex_sum`): the opposite quarters of a cone's inside, once 5e-2 apart from
+//! order 8 to 24, agree to 1e-10 at order 12. Self and edge pairs that reach the collapsed side
+//! keep their transforms, which assume a regular map there and converge only algebraically
+//! near it (a cone's inside against itself: 2.0e-5 at order 12, 6.6e-6 at 16).
+//!
 //! **Nearly touching** pairs (an edge or corner closer than the patch size but not shared) are
 //! handled by the same transforms with the ζ-interval split geometrically down to the gap, so the
 //! near-singular peak is resolved (error bounded independently of the gap).
@@ -556,12 +566,30 @@ where
             let (o, x, y) = ((T::ZERO, T::ZERO), (T::ONE, T::ZERO), (T::ZERO, T::ONE));
             let lengths =
                 [line_length(&la, o, x), line_length(&la, o, y), line_length(&lb, o, x), line_length(&lb, o, y)];
-            let (ext, r0) = extents(lengths);
-            let g = if r0 > T::ZERO { gap * scale / r0 } else { gap };
-            if occluded {
-                vertex_sum(&la, &lb, &rule, occluders, ext, g)
+            // A side through the vertex that collapses to it (a cone's apex): every point of
+            // that side is the vertex, so the variable along it is not singular.
+            let longest = lengths.iter().fold(T::ZERO, |m, l| m.max(*l));
+            let collapsed = lengths.map(|l| l < longest * T::from_f64(1e-6));
+            if collapsed.iter().any(|c| *c) {
+                // The singular variables are the others: extents from their lengths only.
+                let r0 = lengths.iter().zip(&collapsed).filter(|(_, c)| !**c).fold(T::MAX, |m, (l, _)| m.min(*l));
+                let max = T::from_f64(MAX_EXTENT);
+                let ext = lengths.map(|l| if r0 > T::ZERO { (l / r0).max(T::ONE).min(max) } else { T::ONE });
+                let g = if r0 > T::ZERO && r0 < T::MAX { gap * scale / r0 } else { gap };
+                let singular = collapsed.map(|c| !c);
+                if occluded {
+                    collapsed_vertex_sum(&la, &lb, &rule, occluders, ext, singular, g)
+                } else {
+                    collapsed_vertex_sum(&la, &lb, &rule, &(), ext, singular, g)
+                }
             } else {
-                vertex_sum(&la, &lb, &rule, &(), ext, g)
+                let (ext, r0) = extents(lengths);
+                let g = if r0 > T::ZERO { gap * scale / r0 } else { gap };
+                if occluded {
+                    vertex_sum(&la, &lb, &rule, occluders, ext, g)
+                } else {
+                    vertex_sum(&la, &lb, &rule, &(), ext, g)
+                }
             }
         }
         Adjacency::Separate | Adjacency::Identical => return Err(PdmError::Degenerate),
@@ -672,16 +700,41 @@ where
     (total.value(), count)
 }
 
-/// Whether one side of the patch collapses to a point (a cone's apex, a disk's centre, a
-/// sphere's pole): its length is below 1e-6 of the longest side. Near such a side the
-/// parameterisation is singular and the transforms, which assume a regular map at the contact,
-/// converge only algebraically on pairs touching there.
-pub(crate) fn has_collapsed_side<T: Real, S: Surface<T> + ?Sized>(patch: &Patch<'_, T, S>) -> bool {
-    let l = Local { patch, map: SquareMap::IDENTITY };
+/// Whether the contact of a touching or identical pair reaches a side of a patch that
+/// collapses to a point (a cone's apex, a disk's centre, a sphere's pole: shorter than 1e-6 of
+/// the patch's longest side). The self and edge transforms assume a regular map along the
+/// contact and converge only algebraically there: any collapsed side for the same patch twice,
+/// a collapsed side at either end of a shared edge. Vertex pairs have their own sum for it
+/// (`collapsed_vertex_sum`) and are not affected.
+pub(crate) fn contact_reaches_collapsed_side<T, SA, SB>(
+    a: &Patch<'_, T, SA>,
+    b: &Patch<'_, T, SB>,
+    adjacency: Adjacency,
+) -> bool
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+{
     let (o, x, y, xy) = ((T::ZERO, T::ZERO), (T::ONE, T::ZERO), (T::ZERO, T::ONE), (T::ONE, T::ONE));
-    let sides = [line_length(&l, o, x), line_length(&l, y, xy), line_length(&l, o, y), line_length(&l, x, xy)];
-    let longest = sides.iter().fold(T::ZERO, |m, s| m.max(*s));
-    sides.iter().any(|s| *s < longest * T::from_f64(1e-6))
+    // Lengths of the local sides η = 0, η = 1, ξ = 0, ξ = 1, and whether each is collapsed.
+    fn collapsed<T: Real, S: Surface<T> + ?Sized>(l: &Local<'_, '_, T, S>, sides: [(T, T); 5]) -> [bool; 4] {
+        let [o, x, y, xy, _] = sides;
+        let lengths = [line_length(l, o, x), line_length(l, y, xy), line_length(l, o, y), line_length(l, x, xy)];
+        let longest = lengths.iter().fold(T::ZERO, |m, s| m.max(*s));
+        lengths.map(|s| s < longest * T::from_f64(1e-6))
+    }
+    let sides = [o, x, y, xy, o];
+    match adjacency {
+        Adjacency::Identical => collapsed(&Local { patch: a, map: SquareMap::IDENTITY }, sides).iter().any(|c| *c),
+        Adjacency::SharedEdge { a: ma, b: mb } => {
+            // The shared edge is η = 0; its ends lie on the sides ξ = 0 and ξ = 1.
+            let ca = collapsed(&Local { patch: a, map: ma }, sides);
+            let cb = collapsed(&Local { patch: b, map: mb }, sides);
+            ca.get(2..).is_some_and(|c| c.iter().any(|c| *c)) || cb.get(2..).is_some_and(|c| c.iter().any(|c| *c))
+        }
+        Adjacency::SharedVertex { .. } | Adjacency::Separate => false,
+    }
 }
 
 /// Length of the local coordinate line from `p` to `q` (a 4-segment polyline).
@@ -1018,6 +1071,98 @@ where
         return T::ONE;
     }
     (na.scale(T::ONE / la) + nb.scale(T::ONE / lb)).norm()
+}
+
+/// The vertex sum when a side through the common vertex collapses to it (module docs, "A side
+/// collapsed to a point"): variables x = (ξ_a, η_a, ξ_b, η_b); `singular[i]` marks the variables
+/// that vanish at the contact (the others run along a collapsed side and stay free). The
+/// singular ones, scaled by `ext`, are split into pyramids by the largest (ζ, the others
+/// ζ·m·ρ, Jacobian ζ^(k−1)·Π m for k singular variables) in ζ-shells as in `vertex_sum`; the
+/// free ones get the plain rule.
+#[allow(clippy::too_many_arguments)]
+fn collapsed_vertex_sum<T, SA, SB, O>(
+    a: &Local<'_, '_, T, SA>,
+    b: &Local<'_, '_, T, SB>,
+    rule: &GaussRule<T>,
+    occ: &O,
+    ext: [T; 4],
+    singular: [bool; 4],
+    gap: T,
+) -> T
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
+    let mut total = Compensated::default();
+    let k = singular.iter().filter(|s| **s).count();
+    let c = ext.map(|e| T::ONE / e);
+    let jac_scale = (0..4).filter(|&i| singular.get(i).copied().unwrap_or(false)).fold(T::ONE, |j, i| j * at(&c, i));
+    for pyramid in (0..4).filter(|&i| singular.get(i).copied().unwrap_or(false)) {
+        let others: [usize; 3] = match pyramid {
+            0 => [1, 2, 3],
+            1 => [0, 2, 3],
+            2 => [0, 1, 3],
+            _ => [0, 1, 2],
+        };
+        let ek = at(&ext, pyramid);
+        let mut breaks = [T::ZERO; 3];
+        for (slot, &i) in breaks.iter_mut().zip(&others) {
+            *slot = if singular.get(i).copied().unwrap_or(false) { at(&ext, i) } else { T::ZERO };
+        }
+        for_each_shell(gap, ek, &breaks, |z0, z1| {
+            let dz = z1 - z0;
+            for (zu, wz) in unit_points(rule) {
+                let (zeta, wz) = (z0 + dz * zu, wz * dz);
+                // m_i = min(1, ext_i/ζ) for the singular ratios, 1 for the free variables.
+                let m = others.map(|i| {
+                    if singular.get(i).copied().unwrap_or(false) {
+                        (at(&ext, i) / zeta).min(T::ONE)
+                    } else {
+                        T::ONE
+                    }
+                });
+                let mut jac = jac_scale;
+                for _ in 1..k {
+                    jac *= zeta;
+                }
+                for (slot, &i) in others.iter().enumerate() {
+                    if singular.get(i).copied().unwrap_or(false) {
+                        jac *= at(&m, slot);
+                    }
+                }
+                let var = |slot: usize, r: T| {
+                    let i = others.get(slot).copied().unwrap_or(0);
+                    if singular.get(i).copied().unwrap_or(false) {
+                        (zeta * at(&m, slot) * r * at(&c, i)).min(T::ONE)
+                    } else {
+                        r
+                    }
+                };
+                let xz = (zeta * at(&c, pyramid)).min(T::ONE);
+                for (pu, wp) in unit_points(rule) {
+                    for (qu, wq) in unit_points(rule) {
+                        let mut line = T::ZERO;
+                        for (ru, wr) in unit_points(rule) {
+                            let (x1, x2, x3) = (var(0, pu), var(1, qu), var(2, ru));
+                            let x = match pyramid {
+                                0 => [xz, x1, x2, x3],
+                                1 => [x1, xz, x2, x3],
+                                2 => [x1, x2, xz, x3],
+                                _ => [x1, x2, x3, xz],
+                            };
+                            let (pa, na) = a.eval(at(&x, 0), at(&x, 1));
+                            let (pb, nb) = b.eval(at(&x, 2), at(&x, 3));
+                            line += wr * kernel(pa, na, pb, nb, occ);
+                        }
+                        total.add(wz * wp * wq * jac * line);
+                    }
+                }
+            }
+        });
+    }
+    total.value()
 }
 
 fn vertex_sum<T, SA, SB, O>(
