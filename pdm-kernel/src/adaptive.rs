@@ -58,7 +58,8 @@
 //!   ([`crate::singular`]): without an occluder that may cut the patch's view of itself, as a
 //!   touching pair (orders 4, 6, …, both copies split 2 × 2 at `max_order`; a quarter of a
 //!   tube's inside meets 1e-10 with 2.2e5 evaluations). With one, the shadow makes the
-//!   integrand jump and the convergence algebraic: the value at p = `max_order` with 2 × the
+//!   integrand jump, and on a saddle the facing test puts kinks in it; the convergence is then
+//!   algebraic: the value at p = `max_order` with 2 × the
 //!   largest difference from orders p − 1, p − 2, p − 3 and p/2, not split (splitting a self
 //!   pair that an occluder cuts multiplies the touching sub-pairs at every level); above the
 //!   tolerance it says so with `converged = false` (three quarters of a tube's inside around
@@ -317,8 +318,10 @@ where
 /// ([`identical_unchecked`](crate::singular)). Without an occluder that may cut the patch's
 /// view of itself the kernel is smooth in the transformed variables: orders 4, 6, … as for a
 /// touching pair, splitting both copies 2 × 2 at `max_order`. With one, the shadow makes the
-/// integrand jump and the convergence algebraic: the value at p = `max_order`, estimated as
-/// 2 × the largest difference from orders p − 1, p − 2, p − 3 and p/2 (module docs), not split.
+/// integrand jump, and on a patch that faces itself in some directions and away in others (a
+/// saddle: `singular::faces_itself_mixed`) the facing test puts kinks in it: the convergence is
+/// algebraic, so the value at p = `max_order` is estimated as 2 × the largest difference from
+/// orders p − 1, p − 2, p − 3 and p/2 (module docs), not split.
 #[inline(never)]
 fn identical<T, S, O, const CAP: usize>(
     a: &Patch<'_, T, S>,
@@ -332,7 +335,7 @@ where
     O: Occluder<T> + ?Sized,
 {
     let ball = a.enclosing_ball();
-    if !occluders.may_block_between(&ball, &ball) {
+    if !occluders.may_block_between(&ball, &ball) && !crate::singular::faces_itself_mixed(a) {
         let eval = |p: usize| crate::singular::identical_unchecked(a, p, occluders);
         return by_order_doubling::<T, S, S, O, CAP>(a, a, settings, occluders, depth, eval, 4, Split::Both);
     }

@@ -85,7 +85,9 @@ impl PairSettings {
 ///   of a radius of 5: 1e-3);
 /// - self and edge pairs reaching a side that collapses to a point on a concave surface (the
 ///   pieces of a cone's inside at its apex: the whole wall against itself 2.0e-5 off at
-///   singular order 12, 6.6e-6 at 16; a frustum, without the apex, 8e-11).
+///   singular order 12, 6.6e-6 at 16; a frustum, without the apex, 8e-11);
+/// - a saddle against itself (it faces itself in some directions only: the facing test puts
+///   kinks in the self kernel).
 ///
 /// For a guaranteed accuracy use [`crate::adaptive_exchange`], whose estimate bounds the
 /// error and whose `converged` flag says whether the tolerance was met.

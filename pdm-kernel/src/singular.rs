@@ -700,6 +700,43 @@ where
     (total.value(), count)
 }
 
+/// Whether the patch faces itself in some directions and away from itself in others (a saddle,
+/// or a surface concave in one region and convex in another): the section 3.2 facing test then
+/// cuts the self kernel along directions where the curvature changes sign, and the
+/// identical-panel transform converges only algebraically. Probed on a 5 × 5 grid of points,
+/// each towards 8 neighbours an eighth of the patch away; a facing value counts only beyond
+/// 1e-8 of |n|·|e| (flat patches, whose values are rounding, are not mixed).
+pub(crate) fn faces_itself_mixed<T: Real, S: Surface<T> + ?Sized>(patch: &Patch<'_, T, S>) -> bool {
+    let l = Local { patch, map: SquareMap::IDENTITY };
+    let (mut toward, mut away) = (false, false);
+    let step = T::from_f64(0.125);
+    let tol = T::from_f64(1e-8);
+    for i in 0..5 {
+        for j in 0..5 {
+            let (x, y) = (T::from_usize(i) * T::from_f64(0.25), T::from_usize(j) * T::from_f64(0.25));
+            let (p, n) = l.eval(x, y);
+            for (dx, dy) in
+                [(1.0, 0.0), (1.0, 1.0), (0.0, 1.0), (-1.0, 1.0), (-1.0, 0.0), (-1.0, -1.0), (0.0, -1.0), (1.0, -1.0)]
+            {
+                let (xq, yq) = (x + step * T::from_f64(dx), y + step * T::from_f64(dy));
+                if !(xq >= T::ZERO && xq <= T::ONE && yq >= T::ZERO && yq <= T::ONE) {
+                    continue;
+                }
+                let (q, m) = l.eval(xq, yq);
+                let e = q - p;
+                let (ca, cb) = (n.dot(e), -m.dot(e));
+                let (sa, sb) = (tol * n.norm() * e.norm(), tol * m.norm() * e.norm());
+                toward |= ca > sa || cb > sb;
+                away |= ca < -sa || cb < -sb;
+                if toward && away {
+                    return true;
+                }
+            }
+        }
+    }
+    false
+}
+
 /// Whether the contact of a touching or identical pair reaches a side of a patch that
 /// collapses to a point (a cone's apex, a disk's centre, a sphere's pole: shorter than 1e-6 of
 /// the patch's longest side). The self and edge transforms assume a regular map along the
@@ -1286,4 +1323,36 @@ where
         });
     }
     total.value()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::surface::{BezierPatch, Cylinder, Disk, Side, Sphere};
+    use crate::vec3::vec3;
+
+    #[test]
+    fn mixed_self_facing_is_found_on_saddles_only() {
+        // z = (x − ½)(y − ½): bilinear, so the bicubic control net holds it exactly.
+        let mut control = [[vec3(0.0, 0.0, 0.0); 4]; 4];
+        for (i, row) in control.iter_mut().enumerate() {
+            for (j, c) in row.iter_mut().enumerate() {
+                let (x, y) = (i as f64 / 3.0, j as f64 / 3.0);
+                *c = vec3(x, y, (x - 0.5) * (y - 0.5));
+            }
+        }
+        let saddle = BezierPatch::new(control).unwrap();
+        assert!(faces_itself_mixed(&Patch::whole(&saddle).unwrap()));
+        let o = vec3(0.0, 0.0, 0.0);
+        let z = vec3(0.0, 0.0, 1.0);
+        let tube = Cylinder::new(o, z, 0.5, 1.0, Side::Inner).unwrap();
+        let outside = Cylinder::new(o, z, 0.5, 1.0, Side::Outer).unwrap();
+        let ball = Sphere::inner(o, 1.0).unwrap();
+        let disk = Disk::new(o, z, 1.0).unwrap();
+        let quarter = |s: &dyn Surface<f64>| {
+            let r = Patch::whole(s).unwrap().rect();
+            !faces_itself_mixed(&Patch::new(s, r.cell(0, 0, 4, 2)).unwrap())
+        };
+        assert!(quarter(&tube) && quarter(&outside) && quarter(&ball) && quarter(&disk));
+    }
 }
