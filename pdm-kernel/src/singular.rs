@@ -72,7 +72,9 @@
 //! three-quarter points coincide too (so the two parameterisations agree along it, as the
 //! transform requires). `Identical` needs all four corners, the centres and the normals there to
 //! agree. A contact the working precision cannot resolve (the rounding band not small against
-//! the shortest edge × the fold angle) is refused with `Err(Degenerate)`.
+//! the shortest edge × the fold angle) is refused with `Err(Degenerate)`; a near contact whose
+//! only unresolved part is the fold angle (parallel patches facing each other across a small gap,
+//! edge above edge) is nearly coincident, not nearly folded, and is reported as `Separate`.
 
 use crate::error::PdmError;
 use crate::gauss::GaussRule;
@@ -336,13 +338,17 @@ where
     // radius 2.5e-29 at x = −85, `cargo fuzz`) would otherwise pass on the other patch's edges
     // alone and send rounding noise through the graded transforms (a 30 s timeout).
     let smallest_patch = diameter(&ca).min(diameter(&cb));
+    // A near contact whose geometry is resolved but whose fold parameter is not (two parallel
+    // patches facing each other across a small gap, edge above edge: nearly coincident rather
+    // than nearly folded) is no contact the transforms can use: it is reported as separate, and
+    // the separate paths integrate it.
     let flag = |adjacency: Adjacency, gap: T, sensitivity: T| {
         let resolution = T::from_f64(RESOLUTION);
-        let resolved = shortest < T::MAX
-            && band <= resolution * shortest * sensitivity.min(T::ONE)
-            && band <= resolution * smallest_patch;
-        if resolved {
+        let geometry = shortest < T::MAX && band <= resolution * shortest && band <= resolution * smallest_patch;
+        if geometry && band <= resolution * shortest * sensitivity.min(T::ONE) {
             (adjacency, gap)
+        } else if geometry && near {
+            (Adjacency::Separate, T::ZERO)
         } else {
             (adjacency, T::MAX)
         }
