@@ -80,7 +80,7 @@ use crate::form_factor::exchange_unchecked;
 use crate::patch::Patch;
 use crate::real::Real;
 use crate::samples::PatchSamples;
-use crate::singular::{classify_near, touching_unchecked, Adjacency};
+use crate::singular::{classify_near, touching_evaluations, touching_unchecked, Adjacency};
 use crate::surface::{ParamRect, Surface};
 use crate::visibility::Occluder;
 
@@ -250,15 +250,9 @@ where
             if depth < settings.max_depth && occluders.may_block_between(&a.enclosing_ball(), &b.enclosing_ball()) {
                 return split_both::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, 0);
             }
-            let per_order = |p: usize| -> u64 {
-                let p4 = (p as u64).pow(4);
-                if matches!(adjacency, Adjacency::SharedEdge { .. }) {
-                    6 * p4
-                } else {
-                    4 * p4
-                }
+            let eval = |p: usize| {
+                Ok((touching_unchecked(a, b, adjacency, gap, p, occluders)?, touching_evaluations(adjacency, p)))
             };
-            let eval = |p: usize| Ok((touching_unchecked(a, b, adjacency, gap, p, occluders)?, per_order(p)));
             by_order_doubling::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, eval, 4, Split::Both)
         }
         Adjacency::Identical => identical::<T, SA, O, CAP>(a, settings, occluders, depth),
@@ -366,10 +360,7 @@ where
     let eval = |p: usize| -> Result<(T, u64), PdmError> {
         match adjacency {
             Adjacency::Identical => crate::singular::identical_unchecked(a, p, occluders),
-            _ => {
-                let per = if matches!(adjacency, Adjacency::SharedEdge { .. }) { 6 } else { 4 };
-                Ok((touching_unchecked(a, b, adjacency, gap, p, occluders)?, per * (p as u64).pow(4)))
-            }
+            _ => Ok((touching_unchecked(a, b, adjacency, gap, p, occluders)?, touching_evaluations(adjacency, p))),
         }
     };
     algebraic_leaf(eval, settings)

@@ -259,8 +259,7 @@ where
     }
     match adjacency {
         Adjacency::SharedEdge { .. } | Adjacency::SharedVertex { .. } => {
-            let q4 = (settings.singular_order as u64).pow(4);
-            let count = if matches!(adjacency, Adjacency::SharedEdge { .. }) { 6 * q4 } else { 4 * q4 };
+            let count = crate::singular::touching_evaluations(adjacency, settings.singular_order);
             Ok((touching_unchecked(a, b, adjacency, gap, settings.singular_order, occluders)?, count))
         }
         Adjacency::Identical => crate::singular::identical_unchecked(a, settings.singular_order, occluders),

@@ -574,8 +574,7 @@ where
                 [line_length(&la, o, x), line_length(&la, o, y), line_length(&lb, o, x), line_length(&lb, o, y)];
             // A side through the vertex that collapses to it (a cone's apex): every point of
             // that side is the vertex, so the variable along it is not singular.
-            let longest = lengths.iter().fold(T::ZERO, |m, l| m.max(*l));
-            let collapsed = lengths.map(|l| l < longest * T::from_f64(1e-6));
+            let collapsed = collapsed_among(lengths);
             if collapsed.iter().any(|c| *c) {
                 // The singular variables are the others: extents from their lengths only.
                 let r0 = lengths.iter().zip(&collapsed).filter(|(_, c)| !**c).fold(T::MAX, |m, (l, _)| m.min(*l));
@@ -763,9 +762,7 @@ where
     // Lengths of the local sides η = 0, η = 1, ξ = 0, ξ = 1, and whether each is collapsed.
     fn collapsed<T: Real, S: Surface<T> + ?Sized>(l: &Local<'_, '_, T, S>, sides: [(T, T); 5]) -> [bool; 4] {
         let [o, x, y, xy, _] = sides;
-        let lengths = [line_length(l, o, x), line_length(l, y, xy), line_length(l, o, y), line_length(l, x, xy)];
-        let longest = lengths.iter().fold(T::ZERO, |m, s| m.max(*s));
-        lengths.map(|s| s < longest * T::from_f64(1e-6))
+        collapsed_among([line_length(l, o, x), line_length(l, y, xy), line_length(l, o, y), line_length(l, x, xy)])
     }
     let sides = [o, x, y, xy, o];
     match adjacency {
@@ -778,6 +775,19 @@ where
         }
         Adjacency::SharedVertex { .. } | Adjacency::Separate => false,
     }
+}
+
+/// Which of these side lengths collapse to a point: shorter than 1e-6 of the longest.
+fn collapsed_among<T: Real>(lengths: [T; 4]) -> [bool; 4] {
+    let longest = lengths.iter().fold(T::ZERO, |m, l| m.max(*l));
+    lengths.map(|l| l < longest * T::from_f64(1e-6))
+}
+
+/// The nominal integrand evaluations of a touching transform at `order`: 6·order⁴ for a shared
+/// edge, 4·order⁴ for a shared vertex (times the ζ-shells of long or gapped pairs, not counted).
+pub(crate) fn touching_evaluations(adjacency: Adjacency, order: usize) -> u64 {
+    let per = if matches!(adjacency, Adjacency::SharedEdge { .. }) { 6 } else { 4 };
+    per * (order as u64).pow(4)
 }
 
 /// Length of the local coordinate line from `p` to `q` (a 4-segment polyline).
@@ -1139,10 +1149,11 @@ where
     O: Occluder<T> + ?Sized,
 {
     let mut total = Compensated::default();
+    let is_singular = |i: usize| singular.get(i).copied().unwrap_or(false);
     let k = singular.iter().filter(|s| **s).count();
     let c = ext.map(|e| T::ONE / e);
-    let jac_scale = (0..4).filter(|&i| singular.get(i).copied().unwrap_or(false)).fold(T::ONE, |j, i| j * at(&c, i));
-    for pyramid in (0..4).filter(|&i| singular.get(i).copied().unwrap_or(false)) {
+    let jac_scale = (0..4).filter(|&i| is_singular(i)).fold(T::ONE, |j, i| j * at(&c, i));
+    for pyramid in (0..4).filter(|&i| is_singular(i)) {
         let others: [usize; 3] = match pyramid {
             0 => [1, 2, 3],
             1 => [0, 2, 3],
@@ -1152,32 +1163,26 @@ where
         let ek = at(&ext, pyramid);
         let mut breaks = [T::ZERO; 3];
         for (slot, &i) in breaks.iter_mut().zip(&others) {
-            *slot = if singular.get(i).copied().unwrap_or(false) { at(&ext, i) } else { T::ZERO };
+            *slot = if is_singular(i) { at(&ext, i) } else { T::ZERO };
         }
         for_each_shell(gap, ek, &breaks, |z0, z1| {
             let dz = z1 - z0;
             for (zu, wz) in unit_points(rule) {
                 let (zeta, wz) = (z0 + dz * zu, wz * dz);
                 // m_i = min(1, ext_i/ζ) for the singular ratios, 1 for the free variables.
-                let m = others.map(|i| {
-                    if singular.get(i).copied().unwrap_or(false) {
-                        (at(&ext, i) / zeta).min(T::ONE)
-                    } else {
-                        T::ONE
-                    }
-                });
+                let m = others.map(|i| if is_singular(i) { (at(&ext, i) / zeta).min(T::ONE) } else { T::ONE });
                 let mut jac = jac_scale;
                 for _ in 1..k {
                     jac *= zeta;
                 }
                 for (slot, &i) in others.iter().enumerate() {
-                    if singular.get(i).copied().unwrap_or(false) {
+                    if is_singular(i) {
                         jac *= at(&m, slot);
                     }
                 }
                 let var = |slot: usize, r: T| {
                     let i = others.get(slot).copied().unwrap_or(0);
-                    if singular.get(i).copied().unwrap_or(false) {
+                    if is_singular(i) {
                         (zeta * at(&m, slot) * r * at(&c, i)).min(T::ONE)
                     } else {
                         r
