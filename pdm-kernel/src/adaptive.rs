@@ -3,8 +3,9 @@
 //! [`adaptive_exchange`] returns A_a·F_{a→b} with an error estimate, whether that estimate met
 //! the tolerance, and the number of integrand evaluations it took. Per pair it
 //! 1. classifies the pair ([`classify_near`]): flat pairs that see each other wholly use the
-//!    contour form at two orders (where its terms cancel beyond the working precision, the
-//!    paths below take the pair if their rules resolve it, else `Err(Unresolvable)`);
+//!    contour form at two orders or more (where its terms cancel beyond the working precision,
+//!    the paths below take the pair if their rules resolve it, else the contour value stands
+//!    with its rounding bound in the estimate);
 //!    touching pairs use the regularising transforms, raising the order by 2 from 4; the same
 //!    patch twice uses the identical-panel transform (see below);
 //! 2. for separate pairs, starts from an order chosen from the geometry — the Gauss error on an
@@ -30,8 +31,9 @@
 //! Each leaf pair's estimate is a difference between independent approximations, times a
 //! safety factor where the convergence is only algebraic, plus a rounding allowance of
 //! 128 ε·|value| (2.8e-14 relative in f64, 1.5e-5 in f32); the total is the sum over the
-//! leaves. [`Estimate::converged`] is `true` only if every leaf met the tolerance
-//! (estimate ≤ tolerance·|value|, or value and estimate both zero); at the depth limit, or
+//! leaves. [`Estimate::converged`] is `true` if every leaf met the tolerance (estimate ≤
+//! tolerance·|value|, or value and estimate both zero) or the total estimate meets it against
+//! the total value; at the depth limit, or
 //! where the precision floor stops progress (a tolerance below 128 ε can never be met), the
 //! best value is returned with its estimate and `converged = false` — never silently above
 //! the tolerance. A caller who needs the tolerance checks the flag (or compares `error` with
@@ -42,8 +44,9 @@
 //!   (d₂ alone on a separate pair's first comparison, whose start order the geometry chose);
 //!   touching pairs compare at least three orders. The geometric mean covers convergence that
 //!   stalls for a step (checked against closed forms and the contour integral in the tests).
-//! * Flat pairs by the contour form: the difference between orders 8 and 16 (within
-//!   `max_order`) plus the bound on the rounding of the cancelling terms.
+//! * Flat pairs by the contour form: the difference between orders 8 and 16 (then 24, 32
+//!   until it meets the tolerance: the contour's 1-D rules are not bound by `max_order`) plus
+//!   the bound on the rounding of the cancelling terms.
 //! * Pairs across visibility boundaries: the outer integrand keeps kinks (a shadow edge meeting
 //!   an inner edge), so successive orders — and a patch and its halves — can agree by
 //!   accident. Four approximations are computed: the outer patch whole and split 2 × 2, each
@@ -206,6 +209,10 @@ where
     // The leaves are unchecked approximations: the total may overshoot [0, min(A_a, A_b)] by
     // its error, and is clamped there; beyond its error it is refused.
     e.value = crate::bounds::exchange_within(e.value, e.error, area_a, area_b)?;
+    // The leaves judge their own estimates against their own values; a leaf of a tiny value
+    // may miss that while the total meets the tolerance asked for (the pieces of a whole disk
+    // far from the other's rim): the sum of the estimates bounds the total's error.
+    e.converged |= e.error <= settings.tolerance * e.value.abs();
     Ok(e)
 }
 
@@ -227,16 +234,19 @@ where
     #[cfg(feature = "closed-form")]
     if crate::pair::contour_applies(adjacency, gap) {
         let lo_order = 8usize.min(settings.max_order);
-        // Where the contour terms cancel beyond the working precision (`Unresolvable`: f32
-        // cells close together), the 4-D path below takes the pair instead if its Gauss rules
-        // resolve the pair at `max_order`; otherwise (long strips close together, whose ends
-        // no node comes near) two approximations can agree on a wrong value, and the refusal
-        // stands.
+        // Where the contour terms cancel beyond the working precision (f32 cells close
+        // together) or the gap is below the geometry's resolution (`Unresolvable`), the 4-D
+        // path below takes the pair instead if its Gauss rules resolve the pair at
+        // `max_order`; otherwise (long strips close together, whose ends no node comes near)
+        // two approximations can agree on a wrong value: the contour value stands with its
+        // rounding bound in the estimate, and the refusal of an unresolvable gap stands.
         match contour_leaf(a, b, lo_order, settings, occluders) {
             Some(Err(PdmError::Unresolvable))
                 if adjacency != Adjacency::Separate || resolved::<T, SA, SB, CAP>(a, b, settings.max_order)? => {}
+            Some(Ok((_, true)))
+                if adjacency != Adjacency::Separate || resolved::<T, SA, SB, CAP>(a, b, settings.max_order)? => {}
             None => {}
-            Some(result) => return result,
+            Some(result) => return result.map(|(estimate, _)| estimate),
         }
     }
     if crate::singular::contact_reaches_collapsed_side(a, b, adjacency) {
@@ -260,9 +270,13 @@ where
     }
 }
 
-/// The contour form ([`crate::pair::flat_pair`]) at `lo_order` and twice that (within
-/// `max_order`): the difference plus the rounding bound is the estimate. `None` if the pair is
-/// not a flat pair that sees itself wholly.
+/// The contour form ([`crate::pair::flat_pair`]) at orders `lo_order`, 2·`lo_order`, then up
+/// by 8 to [`MAX_ORDER`](crate::MAX_ORDER) until the difference between the last two plus the
+/// rounding bound, the estimate, meets the tolerance. Its rules are 1-D (cost ∝ p², no sample
+/// buffers), so `max_order`, which bounds the 4-D rules, does not limit them. With the
+/// estimate, whether the value has lost more than half its digits to cancellation
+/// ([`crate::bounds::lost_digits`]). `None` if the pair is not a flat pair that sees itself
+/// wholly.
 #[cfg(feature = "closed-form")]
 fn contour_leaf<T, SA, SB, O>(
     a: &Patch<'_, T, SA>,
@@ -270,28 +284,36 @@ fn contour_leaf<T, SA, SB, O>(
     lo_order: usize,
     settings: Adaptive<T>,
     occluders: &O,
-) -> Option<Result<Estimate<T>, PdmError>>
+) -> Option<Result<(Estimate<T>, bool), PdmError>>
 where
     T: Real,
     SA: Surface<T> + ?Sized,
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
-    let (lo, n_lo, _) = match crate::pair::flat_pair(a, b, lo_order, occluders)? {
+    let (mut lo, mut evaluations, _) = match crate::pair::flat_pair(a, b, lo_order, occluders)? {
         Ok(x) => x,
         Err(e) => return Some(Err(e)),
     };
-    let hi_order = (2 * lo_order).min(settings.max_order.max(lo_order + 1));
-    let (hi, n_hi, rounding) = match crate::pair::flat_pair(a, b, hi_order, occluders)? {
-        Ok(x) => x,
-        Err(e) => return Some(Err(e)),
-    };
-    let difference = (hi - lo).abs() + rounding;
-    Some(Ok(Estimate::leaf(hi, difference, settings.tolerance, n_lo.saturating_add(n_hi))))
+    let mut order = 2 * lo_order;
+    loop {
+        let (hi, n, rounding) = match crate::pair::flat_pair(a, b, order, occluders)? {
+            Ok(x) => x,
+            Err(e) => return Some(Err(e)),
+        };
+        evaluations = evaluations.saturating_add(n);
+        let estimate = Estimate::leaf(hi, (hi - lo).abs() + rounding, settings.tolerance, evaluations);
+        if estimate.converged || order >= crate::gauss::MAX_ORDER {
+            return Some(Ok((estimate, crate::bounds::lost_digits(hi, rounding))));
+        }
+        lo = hi;
+        order = (order + 8).min(crate::gauss::MAX_ORDER);
+    }
 }
 
 /// Whether the Gauss rules of order `order` resolve the pair
 /// ([`crate::form_factor::samples_resolved`]).
+#[cfg(feature = "closed-form")]
 #[inline(never)]
 fn resolved<T, SA, SB, const CAP: usize>(
     a: &Patch<'_, T, SA>,

@@ -73,6 +73,13 @@ pub(crate) fn form_factor<T: Real>(value: T) -> Result<T, PdmError> {
     exchange(value, T::ONE, T::ONE)
 }
 
+/// Whether a value has lost more than half its digits to cancellation: its rounding bound
+/// above √ε of it (1.5e-8 in f64). The contour form's terms cancel so on long thin strips
+/// close together.
+pub(crate) fn lost_digits<T: Real>(value: T, rounding: T) -> bool {
+    rounding > T::EPSILON.sqrt() * value.abs()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,4 +1,4 @@
-//! Flat pairs by the contour (Stokes) form: for two planar polygons that see each other wholly
+//! Flat pairs by the contour (Stokes) form: for two flat patches that see each other wholly
 //! (each in the closed half-space in front of the other, nothing between them),
 //!
 //! A_a·F_{a→b} = (1/2π) ∮_{∂a} ∮_{∂b} ln r  dl_a·dl_b
@@ -23,11 +23,27 @@
 //! Perpendicular edges contribute nothing (d_a·d_b = 0). The geometry is translated to its
 //! centroid and scaled to unit size first (the ln of the scale integrates to zero over a closed
 //! contour), so the logarithms stay O(1) at any scale.
+//!
+//! # Curved edges
+//! The form holds for any two flat patches, whatever their edges: a disk or annulus sector, a
+//! planar Bézier patch, a disk against a parallelogram ([`Outline`], [`curve_exchange`]). An
+//! edge is then the image of a side of the parameter rectangle, x(σ) = g(t(σ), s(σ)) with
+//! x′(σ) from the surface's partial derivatives, and the inner integral
+//! ∫ ln |x − y(τ)| x′·y′(τ) dτ has no closed form. Its integrand is analytic except near the
+//! point of y nearest to x (complex singularities at the distance η of x from y): it is cut
+//! there and graded geometrically towards that point and the edge's ends, down to their
+//! distances from x, so the inner rule converges exponentially at every gap. The outer
+//! integrand is analytic except where x(σ) passes close to an end of y or comes closest to y
+//! (where the edges cross, seen along the normal): cut and graded there the same way. A
+//! parallel edge at a constant small distance (the rims of coaxial disks) needs no cut: the
+//! outer integrand's singularities then lie only at the other edge's ends.
 
 use crate::error::PdmError;
 use crate::gauss::GaussRule;
+use crate::patch::Patch;
 use crate::real::Real;
-use crate::vec3::Vec3;
+use crate::surface::{ParamRect, Surface};
+use crate::vec3::{vec3, Vec3};
 
 /// Most geometric cuts towards one singular point (4^24 ≈ 3e14: any gap above rounding).
 const MAX_LEVELS: usize = 26;
@@ -39,8 +55,8 @@ const MAX_LEVELS: usize = 26;
 ///
 /// The edge-pair terms are O(L² ln L) for edges of length L, the result only O(A·F): for long
 /// thin strips they cancel by many digits. The rounding of the sum is bounded by 8ε times the
-/// sum of the terms' magnitudes; where that bound exceeds √ε of the value (1.5e-8 in f64) the
-/// pair is refused with `Err(Unresolvable)` rather than returned with lost digits.
+/// sum of the terms' magnitudes; the caller refuses a value whose bound exceeds √ε of it
+/// ([`crate::bounds::lost_digits`]) rather than return it with lost digits.
 pub(crate) fn quad_exchange<T: Real>(
     a: &[Vec3<T>; 4],
     b: &[Vec3<T>; 4],
@@ -86,9 +102,6 @@ pub(crate) fn quad_exchange<T: Real>(
         return Err(PdmError::InvalidResult);
     }
     let rounding = T::from_f64(8.0) * T::EPSILON * magnitude;
-    if rounding > T::EPSILON.sqrt() * total.abs() {
-        return Err(PdmError::Unresolvable);
-    }
     let scale = size * size * T::FRAC_1_PI * T::HALF;
     Ok((total * scale, evaluations, rounding * scale))
 }
@@ -246,6 +259,382 @@ fn sort<T: Real>(xs: &mut [T]) {
     }
 }
 
+/// A flat patch's boundary for the contour form: the four edges of its parameter rectangle,
+/// (t0, s0) → (t1, s0) → (t1, s1) → (t0, s1) → (t0, s0), which run counter-clockwise about
+/// ∂g/∂t × ∂g/∂s, with `sign` = −1 when the patch radiates to the other side (reversing a
+/// closed contour negates its integral).
+pub(crate) struct Outline<'p, T: Real, S: Surface<T> + ?Sized> {
+    surface: &'p S,
+    rect: ParamRect<T>,
+    sign: T,
+    /// Edges of non-zero length (a disk sector's edge at r = 0 is a point).
+    live: [bool; 4],
+    /// The unit radiating normal and a point of the plane (the patch's centre).
+    pub(crate) normal: Vec3<T>,
+    pub(crate) origin: Vec3<T>,
+    /// The largest distance of the patch from `origin`.
+    size: T,
+}
+
+/// Grid points per side on which [`Outline::new`] checks that a patch is flat.
+const FLAT_GRID: usize = 7;
+
+impl<'p, T: Real, S: Surface<T> + ?Sized> Outline<'p, T, S> {
+    /// The outline of a flat patch whose surface gives its partial derivatives
+    /// ([`Surface::point_and_partials`]); `None` if it gives none or the patch is not flat: its
+    /// points on a 7 × 7 grid (edges included) within 64 ε of its size from the plane through its
+    /// centre, its unit normals there (where not zero) within 64 ε of the centre's.
+    pub(crate) fn new(p: &Patch<'p, T, S>) -> Option<Self> {
+        let (surface, rect) = (p.surface(), p.rect());
+        let (tm, sm) = ((rect.t0 + rect.t1) * T::HALF, (rect.s0 + rect.s1) * T::HALF);
+        let (origin, gt, gs) = surface.point_and_partials(tm, sm)?;
+        let normal = unit(surface.normal(tm, sm))?;
+        let sign = if normal.dot(gt.cross(gs)) >= T::ZERO { T::ONE } else { -T::ONE };
+        let at = |i: usize, j: usize| {
+            let x = T::from_usize(i) / T::from_usize(FLAT_GRID - 1);
+            let y = T::from_usize(j) / T::from_usize(FLAT_GRID - 1);
+            surface.point_and_normal(rect.t0 + (rect.t1 - rect.t0) * x, rect.s0 + (rect.s1 - rect.s0) * y)
+        };
+        let mut size = T::ZERO;
+        for k in 0..FLAT_GRID * FLAT_GRID {
+            size = size.max((at(k / FLAT_GRID, k % FLAT_GRID).0 - origin).norm());
+        }
+        if !(size > T::ZERO) || !size.is_finite() {
+            return None;
+        }
+        let tolerance = T::from_f64(64.0) * T::EPSILON;
+        for k in 0..FLAT_GRID * FLAT_GRID {
+            let (q, n) = at(k / FLAT_GRID, k % FLAT_GRID);
+            if normal.dot(q - origin).abs() > tolerance * size {
+                return None;
+            }
+            if let Some(n) = unit(n) {
+                if n.dot(normal) < T::ONE - tolerance {
+                    return None;
+                }
+            }
+        }
+        let mut outline = Self { surface, rect, sign, live: [true; 4], normal, origin, size };
+        let mut live = [true; 4];
+        for (k, slot) in live.iter_mut().enumerate() {
+            let longest = [T::ZERO, T::HALF, T::ONE].iter().fold(T::ZERO, |m, &x| m.max(outline.edge(k, x).1.norm()));
+            *slot = longest > size * T::GEOMETRY_TOLERANCE;
+        }
+        outline.live = live;
+        Some(outline)
+    }
+
+    /// Point and derivative d/dτ of edge k at τ ∈ [0, 1] (NaN if the surface stops giving
+    /// partial derivatives, which makes the sum non-finite and refused).
+    fn edge(&self, k: usize, tau: T) -> (Vec3<T>, Vec3<T>) {
+        let r = self.rect;
+        let (wt, ws) = (r.t1 - r.t0, r.s1 - r.s0);
+        let (t, s, along_t, forward) = match k {
+            0 => (r.t0 + wt * tau, r.s0, true, true),
+            1 => (r.t1, r.s0 + ws * tau, false, true),
+            2 => (r.t1 - wt * tau, r.s1, true, false),
+            _ => (r.t0, r.s1 - ws * tau, false, false),
+        };
+        // ∞ · 0: NaN, without a NaN constant in `Real`.
+        let nan = T::MAX * T::TWO * T::ZERO;
+        let nan = vec3(nan, nan, nan);
+        let (p, gt, gs) = self.surface.point_and_partials(t, s).unwrap_or((nan, nan, nan));
+        let d = if along_t { gt.scale(wt) } else { gs.scale(ws) };
+        (p, if forward { d } else { -d })
+    }
+
+    /// Where the patch lies against the plane through `o` with unit normal `n`: `None` if some
+    /// point is behind it by more than `band`, else whether some point is ahead of it by more
+    /// than `band`. The height n·(x − o) is linear on a flat patch: least and largest on its
+    /// edges, each searched by [`minimise`].
+    pub(crate) fn ahead_of(&self, o: Vec3<T>, n: Vec3<T>, band: T) -> Option<bool> {
+        let lowest = |n: Vec3<T>| {
+            (0..4).fold(T::MAX, |m, k| {
+                let height = |x: T| {
+                    let (p, d) = self.edge(k, x);
+                    (n.dot(p - o), n.dot(d))
+                };
+                m.min(minimise(&height, T::ZERO, T::ONE).1)
+            })
+        };
+        if lowest(n) < -band {
+            None
+        } else {
+            Some(-lowest(-n) > band)
+        }
+    }
+
+    /// Its largest distance from its centre.
+    pub(crate) fn size(&self) -> T {
+        self.size
+    }
+}
+
+/// The unit vector along n, `None` for a zero or non-finite n.
+fn unit<T: Real>(n: Vec3<T>) -> Option<Vec3<T>> {
+    let length = n.norm();
+    (length > T::ZERO && length.is_finite()).then(|| n.scale(T::ONE / length))
+}
+
+/// Samples per interval in [`minimise`].
+const MIN_SAMPLES: usize = 8;
+
+/// The least value of a smooth f on [lo, hi], given as x ↦ (f(x), f′(x)): the least of nine
+/// equally spaced samples, refined by a root of f′ (Illinois) in the bracket around it when f′
+/// changes sign there. Returns (x, f(x), evaluations).
+fn minimise<T: Real>(f: &impl Fn(T) -> (T, T), lo: T, hi: T) -> (T, T, u64) {
+    let step = (hi - lo) / T::from_usize(MIN_SAMPLES);
+    let at = |k: usize| if k == MIN_SAMPLES { hi } else { lo + step * T::from_usize(k) };
+    let mut best = (0usize, T::MAX);
+    let mut samples = [(T::ZERO, T::ZERO); MIN_SAMPLES + 1];
+    for (k, slot) in samples.iter_mut().enumerate() {
+        *slot = f(at(k));
+        if slot.0 < best.1 {
+            best = (k, slot.0);
+        }
+    }
+    let mut evaluations = (MIN_SAMPLES + 1) as u64;
+    let (k, value) = best;
+    let (below, above) = (k.saturating_sub(1), (k + 1).min(MIN_SAMPLES));
+    let (Some(&(_, slope_lo)), Some(&(_, slope_hi))) = (samples.get(below), samples.get(above)) else {
+        return (at(k), value, evaluations);
+    };
+    if !(slope_lo < T::ZERO && slope_hi > T::ZERO) {
+        return (at(k), value, evaluations);
+    }
+    let (x, v, n) = slope_root(f, (at(below), slope_lo), (at(above), slope_hi));
+    evaluations += n;
+    if v < value {
+        (x, v, evaluations)
+    } else {
+        (at(k), value, evaluations)
+    }
+}
+
+/// A root of f′ between a (f′ < 0) and b (f′ > 0) by the Illinois variant of regula falsi,
+/// to a few ulps: (x, f(x), evaluations).
+fn slope_root<T: Real>(f: &impl Fn(T) -> (T, T), a: (T, T), b: (T, T)) -> (T, T, u64) {
+    let ((mut lo, mut slo), (mut hi, mut shi)) = (a, b);
+    let mut side = 0i8;
+    let mut evaluations = 0u64;
+    let mut last = (lo, T::MAX);
+    for _ in 0..64 {
+        let mut x = (lo * shi - hi * slo) / (shi - slo);
+        if !(x > lo && x < hi) {
+            x = (lo + hi) * T::HALF;
+        }
+        let (v, s) = f(x);
+        evaluations += 1;
+        last = (x, v);
+        if s < T::ZERO {
+            lo = x;
+            slo = s;
+            if side < 0 {
+                shi *= T::HALF;
+            }
+            side = -1;
+        } else if s > T::ZERO {
+            hi = x;
+            shi = s;
+            if side > 0 {
+                slo *= T::HALF;
+            }
+            side = 1;
+        } else {
+            break;
+        }
+        if !(hi - lo > T::from_f64(4.0) * T::EPSILON * (lo.abs() + hi.abs())) {
+            break;
+        }
+    }
+    (last.0, last.1, evaluations)
+}
+
+/// Local minima at most refined per edge pair where one edge passes close over the other.
+const MAX_CROSSINGS: usize = 3;
+/// Samples of the distance between two edges along the outer one.
+const CROSSING_SAMPLES: usize = 16;
+
+/// A_a·F_{a→b}, the evaluations and a bound on the value's rounding error for two flat patches
+/// with curved edges ([`Outline`]), each wholly in front of (or on) the other's plane, no
+/// occluder between them: the contour form over their edges. There is no closed form for the
+/// inner line integral along a curved edge: for each outer point x it is summed on pieces cut at
+/// the edge's point nearest to x and graded geometrically towards it and towards the ends, down
+/// to the distance of x from them, which makes the inner rule exponential at every gap; the
+/// outer rule is cut where the outer edge passes nearest to the inner edge's ends and where it
+/// comes closest to the inner edge (up to three such places), graded the same way. The rounding
+/// is bounded and refused as in [`quad_exchange`].
+pub(crate) fn curve_exchange<T, SA, SB>(
+    a: &Outline<'_, T, SA>,
+    b: &Outline<'_, T, SB>,
+    order: usize,
+) -> Result<(T, u64, T), PdmError>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+{
+    let rule = GaussRule::<T>::new(order)?;
+    let centroid = (a.origin + b.origin).scale(T::HALF);
+    let size = ((a.origin - centroid).norm() + a.size).max((b.origin - centroid).norm() + b.size);
+    if !(size > T::ZERO) || !size.is_finite() {
+        return Err(PdmError::Degenerate);
+    }
+    let inv = T::ONE / size;
+    let mut total = T::ZERO;
+    let mut magnitude = T::ZERO;
+    let mut evaluations = 0u64;
+    for i in (0..4).filter(|&i| a.live.get(i) == Some(&true)) {
+        let x = |s: T| {
+            let (p, d) = a.edge(i, s);
+            ((p - centroid).scale(inv), d.scale(inv))
+        };
+        for j in (0..4).filter(|&j| b.live.get(j) == Some(&true)) {
+            let y = |s: T| {
+                let (p, d) = b.edge(j, s);
+                ((p - centroid).scale(inv), d.scale(inv))
+            };
+            let (v, m, n) = curve_pair(&rule, &x, &y);
+            total += v;
+            magnitude += m;
+            evaluations = evaluations.saturating_add(n);
+        }
+    }
+    if !total.is_finite() || !magnitude.is_finite() {
+        return Err(PdmError::InvalidResult);
+    }
+    let rounding = T::from_f64(8.0) * T::EPSILON * magnitude;
+    let scale = size * size * T::FRAC_1_PI * T::HALF * a.sign * b.sign;
+    Ok((total * scale, evaluations, rounding * scale.abs()))
+}
+
+/// The point of curve c (τ ↦ (point, d/dτ)) nearest to p: (τ, squared distance, evaluations).
+fn nearest<T: Real>(c: &impl Fn(T) -> (Vec3<T>, Vec3<T>), p: Vec3<T>) -> (T, T, u64) {
+    let f = |tau: T| {
+        let (q, d) = c(tau);
+        let w = q - p;
+        (w.dot(w), T::TWO * w.dot(d))
+    };
+    minimise(&f, T::ZERO, T::ONE)
+}
+
+/// ∫₀¹∫₀¹ ln |x(σ) − y(τ)| x′(σ)·y′(τ) dτ dσ for two curved edges, the same integral of the
+/// integrand's magnitude, and the evaluations (see [`curve_exchange`]).
+fn curve_pair<T: Real>(
+    rule: &GaussRule<T>,
+    x: &impl Fn(T) -> (Vec3<T>, Vec3<T>),
+    y: &impl Fn(T) -> (Vec3<T>, Vec3<T>),
+) -> (T, T, u64) {
+    let count = core::cell::Cell::new(0u64);
+    let tally = |n: u64| count.set(count.get().saturating_add(n));
+    // Squared distance from x(σ) to curve y and its σ-derivative (envelope theorem).
+    let gap = |s: T| {
+        let (p, d) = x(s);
+        let (tau, d2, n) = nearest(y, p);
+        tally(n + 2);
+        (d2, T::TWO * (p - y(tau).0).dot(d))
+    };
+    let (y0, y1) = (y(T::ZERO).0, y(T::ONE).0);
+    let mut cuts = [T::ZERO; 2 + MAX_CROSSINGS];
+    let mut nc = 0usize;
+    let mut add = |c: T| {
+        if c > T::ZERO && c < T::ONE {
+            if let Some(slot) = cuts.get_mut(nc) {
+                *slot = c;
+                nc += 1;
+            }
+        }
+    };
+    for end in [y0, y1] {
+        let towards = |s: T| {
+            let (p, d) = x(s);
+            let w = p - end;
+            (w.dot(w), T::TWO * w.dot(d))
+        };
+        let (s, _, n) = minimise(&towards, T::ZERO, T::ONE);
+        tally(n);
+        add(s);
+    }
+    // Where x passes close over y: interior local minima of the distance, well below its
+    // largest value (a parallel edge at a constant distance has none and needs none).
+    let mut d2 = [T::ZERO; CROSSING_SAMPLES + 1];
+    for (k, slot) in d2.iter_mut().enumerate() {
+        *slot = gap(T::from_usize(k) / T::from_usize(CROSSING_SAMPLES)).0;
+    }
+    let largest = d2.iter().fold(T::ZERO, |m, &v| m.max(v));
+    let mut found = 0usize;
+    // A sample at an end counts too: the closest approach may lie between it and the next
+    // sample, inside the edge (an arc crossing a square's edge just short of its corner).
+    for k in 0..=CROSSING_SAMPLES {
+        let (before, after) = (k.saturating_sub(1), (k + 1).min(CROSSING_SAMPLES));
+        let (Some(&below), Some(&here), Some(&above)) = (d2.get(before), d2.get(k), d2.get(after)) else { continue };
+        if found < MAX_CROSSINGS && here <= below && here <= above && here < largest * T::HALF * T::HALF {
+            let step = T::ONE / T::from_usize(CROSSING_SAMPLES);
+            let (s, _, _) = minimise(&gap, step * T::from_usize(before), step * T::from_usize(after));
+            add(s);
+            found += 1;
+        }
+    }
+    let used = cuts.get_mut(..nc).unwrap_or_default();
+    sort(used);
+    // Distance from x(σ) to y in σ units.
+    let distance = |s: T| {
+        let (d2, _) = gap(s);
+        let speed = x(s).1.norm();
+        if speed > T::ZERO {
+            d2.sqrt() / speed
+        } else {
+            T::MAX
+        }
+    };
+    let inner = |s: T| {
+        let (p, dp) = x(s);
+        let (tau, d2, n) = nearest(y, p);
+        tally(n);
+        let f = |t: T| {
+            let (q, dq) = y(t);
+            let w = q - p;
+            let r2 = w.dot(w);
+            let log = if r2 > T::ZERO { T::HALF * r2.ln() } else { T::ZERO };
+            let v = log * dp.dot(dq);
+            (v, v.abs())
+        };
+        let spacing = |t: T, dist: T| {
+            let speed = y(t).1.norm();
+            if speed > T::ZERO {
+                dist / speed
+            } else {
+                T::MAX
+            }
+        };
+        let to_end = |t: T, q: Vec3<T>| spacing(t, (q - p).norm());
+        let near = spacing(tau, d2.sqrt());
+        let mut sum = (T::ZERO, T::ZERO);
+        if tau > T::ZERO {
+            let (v, n) = graded_piece(rule, T::ZERO, tau, to_end(T::ZERO, y0), near, &f);
+            sum = (sum.0 + v.0, sum.1 + v.1);
+            tally(n);
+        }
+        if tau < T::ONE {
+            let (v, n) = graded_piece(rule, tau, T::ONE, near, to_end(T::ONE, y1), &f);
+            sum = (sum.0 + v.0, sum.1 + v.1);
+            tally(n);
+        }
+        sum
+    };
+    let mut total = (T::ZERO, T::ZERO);
+    let mut lo = T::ZERO;
+    for hi in used.iter().copied().chain(core::iter::once(T::ONE)) {
+        if hi > lo {
+            let (v, n) = graded_piece(rule, lo, hi, distance(lo), distance(hi), &inner);
+            total = (total.0 + v.0, total.1 + v.1);
+            tally(n);
+        }
+        lo = hi;
+    }
+    (total.0, total.1, count.get())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -276,5 +665,70 @@ mod tests {
             let allowed = if h < 1e-6 { 1e-10 } else { 1e-12 };
             assert!(((f - exact) / exact).abs() < allowed, "h = {h}: {f} vs {exact}");
         }
+    }
+
+    /// The graded rules along curved edges against the closed-form inner integral, on
+    /// parallelograms (whose edges either path takes): squares offset so that their edges cross
+    /// seen along the normal, one tilted, gaps 0.3 … 1e-6 — the crossings, the ends passing
+    /// close and the corners over the other's edges are the singular points the outer rule
+    /// must find.
+    #[test]
+    fn graded_edges_agree_with_the_closed_form() {
+        use crate::surface::Parallelogram;
+        for h in [0.3, 1e-2, 1e-4, 1e-6] {
+            for (offset, tilt) in [((0.0, 0.0), 0.0), ((0.37, 0.21), 0.0), ((0.5, -0.45), 0.1), ((0.999, 0.2), 0.0)] {
+                let lower = Parallelogram::new(vec3(0.0, 0.0, 0.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0)).unwrap();
+                let upper =
+                    Parallelogram::new(vec3(offset.0, offset.1, h), vec3(0.0, 0.8, tilt), vec3(1.2, 0.0, 0.0)).unwrap();
+                let (pa, pb) = (Patch::whole(&lower).unwrap(), Patch::whole(&upper).unwrap());
+                let (oa, ob) = (Outline::new(&pa).unwrap(), Outline::new(&pb).unwrap());
+                let (curved, _, rounding) = curve_exchange(&oa, &ob, 16).unwrap();
+                let corners = |p: &Parallelogram<f64>| {
+                    let (o, et, es) = p.affine_map().unwrap();
+                    [o, o + et, o + et + es, o + es]
+                };
+                let (cl, cu) = (corners(&lower), corners(&upper));
+                // The upper one's corners run clockwise about +z, i.e. counter-clockwise about
+                // its radiating normal (−z, towards the lower one).
+                let (closed, _, _) = quad_exchange::<f64>(&cl, &cu, 16).unwrap();
+                // Both sum O(1) terms to a value that can be far smaller (8e-4 where the squares
+                // overlap by 1e-3): the quadrature error scales with the terms, as the rounding
+                // bound (8 ε × their magnitude) does.
+                let difference = (curved - closed).abs();
+                assert!(
+                    difference < 1e-12 * closed + 64.0 * rounding,
+                    "h {h}, offset {offset:?}, tilt {tilt}: {curved} vs {closed}"
+                );
+            }
+        }
+    }
+
+    /// Only flat patches have an outline: a cylinder's wall and a sphere cell have none, a disk
+    /// sector and a planar Bézier patch do (the sector's edge at r = 0 collapses).
+    #[test]
+    fn outlines_of_flat_patches_only() {
+        use crate::surface::{BezierPatch, Cylinder, Disk, ParamRect, Side, Sphere};
+        let z = vec3(0.0, 0.0, 1.0);
+        let wall = Cylinder::new(vec3(0.0, 0.0, 0.0), z, 1.0, 1.0, Side::Outer).unwrap();
+        assert!(Outline::new(&Patch::whole(&wall).unwrap()).is_none());
+        let ball = Sphere::outer(vec3(0.0, 0.0, 0.0), 1.0).unwrap();
+        let cell = ParamRect::new(0.5, 1.0, 0.0, 1.0).unwrap();
+        assert!(Outline::new(&Patch::new(&ball, cell).unwrap()).is_none());
+        let disk = Disk::new(vec3(0.0, 0.0, 0.0), z, 1.0).unwrap();
+        let sector = Outline::new(&Patch::new(&disk, ParamRect::new(0.0, 1.0, 0.0, 1.0).unwrap()).unwrap()).unwrap();
+        assert_eq!(sector.live, [true, true, true, false]);
+        let mut control = [[vec3(0.0, 0.0, 0.0); 4]; 4];
+        for (i, row) in control.iter_mut().enumerate() {
+            for (j, p) in row.iter_mut().enumerate() {
+                *p = vec3(i as f64 + 0.1 * (j * j) as f64, j as f64, 0.0);
+            }
+        }
+        let flat = BezierPatch::new(control).unwrap();
+        assert!(Outline::new(&Patch::whole(&flat).unwrap()).is_some());
+        if let Some(p) = control.get_mut(1).and_then(|row| row.get_mut(2)) {
+            p.z = 0.01;
+        }
+        let bent = BezierPatch::new(control).unwrap();
+        assert!(Outline::new(&Patch::whole(&bent).unwrap()).is_none());
     }
 }

@@ -8,10 +8,13 @@
 //!   transforms of [`crate::singular`], converging exponentially with `singular_order`.
 //! - The same patch twice uses the identical-panel transform of [`crate::singular`],
 //!   converging exponentially with `singular_order` on a smooth patch.
-//! - Two flat patches (parallelograms) that see each other wholly, with no occluder able to cut
-//!   between them and not sharing a whole edge in exact contact, use the contour form
-//!   (`contour.rs`): exact at any gap, from far apart down to nearly coincident, and for a
-//!   partial shared edge (a short edge along a longer one from a common corner).
+//! - Two flat patches that see each other wholly, with no occluder able to cut between them
+//!   and not sharing a whole edge in exact contact, use the contour form (`contour.rs`):
+//!   parallelograms with the inner line integral in closed form, flat patches with curved
+//!   edges (disk and annulus sectors, planar Bézier patches, a disk against a parallelogram)
+//!   with graded rules along both edges ([`Surface::point_and_partials`]). Exponential in the
+//!   order at any gap, from far apart down to nearly coincident, and for a partial shared edge
+//!   (a short edge along a longer one from a common corner).
 //! - Other separate pairs use the PDM sum at `order`. With `boundaries` on, a pair that
 //!   straddles a back-face cut, that an occluder may cut, or whose patches are closer than
 //!   their size gets the visibility boundaries placed into the inner rule and the inner patch
@@ -80,9 +83,9 @@ impl PairSettings {
 /// of it:
 /// - across occluders (a shadow edge meeting the inner patch's corners and edges): about 1e-5
 ///   to 1e-3 relative (a sphere inside a box, floor → the other faces: 4e-4 at order 12);
-/// - curved patches closer than their size to another patch's edge (a sphere cell 0.01 above a
-///   plate's edge region: 1e-4 to 1e-5 at orders 12 to 16; equal coaxial disks 0.01 apart out
-///   of a radius of 5: 1e-3);
+/// - curved (not flat) patches closer than their size to another patch's edge (a sphere cell
+///   0.01 above a plate's edge region: 1e-4 to 1e-5 at orders 12 to 16; two flat patches take
+///   the contour form instead, exact at any gap);
 /// - self and edge pairs reaching a side that collapses to a point on a concave surface (the
 ///   pieces of a cone's inside at its apex: the whole wall against itself 2.0e-5 off at
 ///   singular order 12, 6.6e-6 at 16; a frustum, without the apex, 8e-11);
@@ -142,13 +145,20 @@ where
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
-    let (mut value, mut count) = (T::ZERO, 0u64);
+    let (mut value, mut count, mut rounding) = (T::ZERO, 0u64, T::ZERO);
     for_each_piece_pair(a, b, |pa, pb| {
-        let (v, c) = dispatch::<T, SA, SB, O, CAP>(pa, pb, settings, occluders)?;
+        let (v, c, r) = dispatch::<T, SA, SB, O, CAP>(pa, pb, settings, occluders)?;
         value += v;
         count = count.saturating_add(c);
+        rounding += r;
         Ok(())
     })?;
+    // The contour form's terms can cancel beyond the working precision (long thin strips close
+    // together): judged on the whole pair, not on its pieces (a whole disk's quarter that sees
+    // little of the other disk has a small value and the usual rounding).
+    if crate::bounds::lost_digits(value, rounding) {
+        return Err(PdmError::Unresolvable);
+    }
     let order = settings.order.max(2);
     // A pair whose exact value is the bound (an inner sphere inside an outer one: F = 1)
     // overshoots it by the quadrature error: within `QUADRATURE_BAND` the bound is returned
@@ -233,12 +243,14 @@ pub(crate) fn pieces<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>) -> (u
     (m, n)
 }
 
+/// One piece pair by the method it needs: (value, evaluations, bound on the contour form's
+/// rounding — zero for the other methods).
 fn dispatch<T, SA, SB, O, const CAP: usize>(
     a: &Patch<'_, T, SA>,
     b: &Patch<'_, T, SB>,
     settings: PairSettings,
     occluders: &O,
-) -> Result<(T, u64), PdmError>
+) -> Result<(T, u64, T), PdmError>
 where
     T: Real,
     SA: Surface<T> + ?Sized,
@@ -250,24 +262,26 @@ where
     #[cfg(feature = "closed-form")]
     if settings.boundaries && contour_applies(adjacency, gap) {
         match flat_pair(a, b, settings.order, occluders) {
-            // A touching pair whose contour terms cancel beyond the working precision: the
-            // transforms below take it.
+            // A touching pair whose contour terms cancel beyond the working precision, or
+            // below the geometry's resolution: the transforms below take it.
             Some(Err(PdmError::Unresolvable)) if adjacency != Adjacency::Separate => {}
-            Some(result) => return result.map(|(value, count, _)| (value, count)),
+            Some(Ok((v, _, r))) if adjacency != Adjacency::Separate && crate::bounds::lost_digits(v, r) => {}
+            Some(result) => return result,
             None => {}
         }
     }
+    let exact = |(v, c): (T, u64)| (v, c, T::ZERO);
     match adjacency {
         Adjacency::SharedEdge { .. } | Adjacency::SharedVertex { .. } => {
             let count = crate::singular::touching_evaluations(adjacency, settings.singular_order);
-            Ok((touching_unchecked(a, b, adjacency, gap, settings.singular_order, occluders)?, count))
+            Ok(exact((touching_unchecked(a, b, adjacency, gap, settings.singular_order, occluders)?, count)))
         }
-        Adjacency::Identical => crate::singular::identical_unchecked(a, settings.singular_order, occluders),
+        Adjacency::Identical => crate::singular::identical_unchecked(a, settings.singular_order, occluders).map(exact),
         Adjacency::Separate => {
             let sa = PatchSamples::<T, CAP>::new(a, settings.order)?;
             let sb = PatchSamples::<T, CAP>::new(b, settings.order)?;
             if !settings.boundaries {
-                return Ok((exchange_unchecked(&sa, &sb, occluders)?, p4));
+                return Ok(exact((exchange_unchecked(&sa, &sb, occluders)?, p4)));
             }
             // The sample balls decide for the plain sum; the integrand is smooth only if no
             // occluder cuts any segment between the patches (enclosing balls).
@@ -277,9 +291,9 @@ where
                 // The inner rule is in closed form only on a flat (affine) inner patch: put it
                 // inside when only one of the two is flat.
                 if has_affine_map(b) || !has_affine_map(a) {
-                    occluded::<T, SA, SB, O, CAP>(a, b, settings.order, occluders)
+                    occluded::<T, SA, SB, O, CAP>(a, b, settings.order, occluders).map(exact)
                 } else {
-                    occluded::<T, SB, SA, O, CAP>(b, a, settings.order, occluders)
+                    occluded::<T, SB, SA, O, CAP>(b, a, settings.order, occluders).map(exact)
                 }
             } else if straddles_curvature_cut(&sa, &sb) || near(&a.enclosing_ball(), &b.enclosing_ball()) {
                 let swap = outer_is_b(a, b, &sa, &sb);
@@ -288,10 +302,10 @@ where
                 } else {
                     boundary_unchecked::<T, SA, SB, (), CAP>(a, b, settings.order, &())?
                 };
-                Ok((v, c.saturating_add(p4)))
+                Ok(exact((v, c.saturating_add(p4))))
             } else {
                 // Smooth pair: nothing to place into the rule, no occluder can cut it.
-                Ok((exchange_unchecked(&sa, &sb, &())?, 2 * p4))
+                Ok(exact((exchange_unchecked(&sa, &sb, &())?, 2 * p4)))
             }
         }
     }
@@ -455,6 +469,7 @@ fn is_flat<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>) -> bool {
 /// contact the vertex transform does not expect (it converges only algebraically there). Two
 /// patches sharing a whole edge in exact contact keep the edge transform; the same patch twice
 /// the identical-panel transform.
+#[cfg(feature = "closed-form")]
 pub(crate) fn contour_applies<T: Real>(adjacency: Adjacency, gap: T) -> bool {
     match adjacency {
         Adjacency::Separate | Adjacency::SharedVertex { .. } => true,
@@ -463,14 +478,16 @@ pub(crate) fn contour_applies<T: Real>(adjacency: Adjacency, gap: T) -> bool {
     }
 }
 
-/// Two flat patches (parallelograms) that see each other wholly — each in the closed half-space
-/// in front of the other, not coplanar, no occluder able to cut a segment between them — by the
-/// contour form ([`crate::contour`]), exact at any gap and aspect ratio; `None` if the pair is
-/// not such a pair. Gives the value, the evaluations and a bound on the value's rounding error.
+/// Two flat patches that see each other wholly — each in the closed half-space in front of the
+/// other, not coplanar, no occluder able to cut a segment between them — by the contour form
+/// ([`crate::contour`]: parallelograms in closed form along the inner edge, curved edges by
+/// graded rules), exponential at any gap and aspect ratio; `None` if the pair is not such a
+/// pair. Gives the value, the evaluations and a bound on the value's rounding error (the
+/// caller refuses values that lost half their digits, [`crate::bounds::lost_digits`]).
 #[cfg(feature = "closed-form")]
-pub(crate) fn flat_pair<T, SA, SB, O>(
-    a: &Patch<'_, T, SA>,
-    b: &Patch<'_, T, SB>,
+pub(crate) fn flat_pair<'p, 'r, T, SA, SB, O>(
+    a: &Patch<'p, T, SA>,
+    b: &Patch<'r, T, SB>,
     order: usize,
     occluders: &O,
 ) -> Option<Result<(T, u64, T), PdmError>>
@@ -480,36 +497,53 @@ where
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
-    let (ca, na) = flat_corners(a)?;
-    let (cb, nb) = flat_corners(b)?;
-    // Each wholly in front of (or on) the other's plane, and not both in one plane.
-    let size = ca.iter().chain(cb.iter()).fold(T::ZERO, |m, &p| m.max((p - ca[0]).norm()));
-    let band = size * T::GEOMETRY_TOLERANCE;
-    let side = |corners: &[Vec3<T>; 4], origin: Vec3<T>, n: Vec3<T>| {
-        let mut ahead = false;
-        for &q in corners {
-            let h = n.dot(q - origin);
-            if h < -band {
-                return None;
+    // Parallelograms by their corners, other flat patches by their outlines; each wholly in
+    // front of (or on) the other's plane, and not both in one plane.
+    let (shape, b_ahead, a_ahead, cos) = if let (Some((ca, na)), Some((cb, nb))) = (flat_corners(a), flat_corners(b)) {
+        let size = ca.iter().chain(cb.iter()).fold(T::ZERO, |m, &p| m.max((p - ca[0]).norm()));
+        let band = size * T::GEOMETRY_TOLERANCE;
+        let side = |corners: &[Vec3<T>; 4], origin: Vec3<T>, n: Vec3<T>| {
+            let mut ahead = false;
+            for &q in corners {
+                let h = n.dot(q - origin);
+                if h < -band {
+                    return None;
+                }
+                ahead |= h > band;
             }
-            ahead |= h > band;
-        }
-        Some(ahead)
+            Some(ahead)
+        };
+        (FlatShape::Corners(ca, cb), side(&cb, ca[0], na)?, side(&ca, cb[0], nb)?, na.dot(nb))
+    } else {
+        let oa = crate::contour::Outline::new(a)?;
+        let ob = crate::contour::Outline::new(b)?;
+        let band = oa.size().max(ob.size()) * T::GEOMETRY_TOLERANCE;
+        let (b_ahead, a_ahead) = (ob.ahead_of(oa.origin, oa.normal, band)?, oa.ahead_of(ob.origin, ob.normal, band)?);
+        let cos = oa.normal.dot(ob.normal);
+        (FlatShape::Outlines(oa, ob), b_ahead, a_ahead, cos)
     };
-    let (b_ahead, a_ahead) = (side(&cb, ca[0], na)?, side(&ca, cb[0], nb)?);
-    if !(b_ahead && a_ahead) {
-        // Each within the other's plane to the working precision while facing each other: a
-        // gap below the geometry's resolution (f32 plates 1e-6 apart), which no path can
-        // integrate (the 4-D rules would return a value off by percents).
-        if !b_ahead && !a_ahead && na.dot(nb) < T::ZERO {
-            return Some(Err(PdmError::Unresolvable));
+    if b_ahead && a_ahead {
+        if occluders.may_block_between(&a.enclosing_ball(), &b.enclosing_ball()) {
+            return None;
         }
-        return None;
+        let order = order.max(4);
+        return Some(match shape {
+            FlatShape::Corners(ca, cb) => crate::contour::quad_exchange(&ca, &cb, order),
+            FlatShape::Outlines(oa, ob) => crate::contour::curve_exchange(&oa, &ob, order),
+        });
     }
-    if occluders.may_block_between(&a.enclosing_ball(), &b.enclosing_ball()) {
-        return None;
-    }
-    Some(crate::contour::quad_exchange(&ca, &cb, order.max(4)))
+    // Each within the other's plane to the working precision while facing each other: a gap
+    // below the geometry's resolution (f32 plates 1e-6 apart), which no path can integrate
+    // (the 4-D rules would return a value off by percents).
+    (!b_ahead && !a_ahead && cos < T::ZERO).then_some(Err(PdmError::Unresolvable))
+}
+
+/// The two flat patches of [`flat_pair`]: parallelograms by their corners (inner line
+/// integrals in closed form), any other flat patches by their outlines.
+#[cfg(feature = "closed-form")]
+enum FlatShape<'p, 'r, T: Real, SA: Surface<T> + ?Sized, SB: Surface<T> + ?Sized> {
+    Corners([Vec3<T>; 4], [Vec3<T>; 4]),
+    Outlines(crate::contour::Outline<'p, T, SA>, crate::contour::Outline<'r, T, SB>),
 }
 
 /// A flat patch's corners counter-clockwise about its radiating normal, and its unit normal.

@@ -86,6 +86,10 @@ impl<T: Real> Surface<T> for BezierPatch<T> {
         let gs = self.combine(bernstein::<T, T>(t), bernstein_derivative(s));
         gt.cross(gs)
     }
+    #[cfg(feature = "closed-form")]
+    fn point_and_partials(&self, t: T, s: T) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {
+        Some(super::dual_partials(self, t, s))
+    }
 }
 
 #[cfg(test)]

@@ -78,6 +78,10 @@ impl<T: Real> Surface<T> for Cone<T> {
             n
         }
     }
+    #[cfg(feature = "closed-form")]
+    fn point_and_partials(&self, t: T, s: T) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {
+        Some(super::dual_partials(self, t, s))
+    }
 }
 
 #[cfg(test)]

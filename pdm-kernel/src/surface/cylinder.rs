@@ -81,6 +81,10 @@ impl<T: Real> Surface<T> for Cylinder<T> {
             n
         }
     }
+    #[cfg(feature = "closed-form")]
+    fn point_and_partials(&self, t: T, s: T) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {
+        Some(super::dual_partials(self, t, s))
+    }
 }
 
 #[cfg(test)]

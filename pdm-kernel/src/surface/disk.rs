@@ -76,6 +76,10 @@ impl<T: Real> Surface<T> for Disk<T> {
     fn normal(&self, r: T, _theta: T) -> Vec3<T> {
         self.frame.axis.scale(r)
     }
+    #[cfg(feature = "closed-form")]
+    fn point_and_partials(&self, t: T, s: T) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {
+        Some(super::dual_partials(self, t, s))
+    }
 }
 
 #[cfg(test)]

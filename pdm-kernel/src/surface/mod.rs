@@ -121,6 +121,18 @@ pub trait Surface<T: Real> {
     fn affine_map(&self) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {
         None
     }
+    /// `Some((g, ∂g/∂t, ∂g/∂s))` at (t, s): the point and the tangents of the patch's edges,
+    /// along which the contour form of two flat patches integrates ([`crate::pair_exchange`]:
+    /// flat pairs with curved edges, such as disk and annulus sectors, nearly coincident or
+    /// not). The built-in surfaces and [`AutoNormal`] provide them (exact, by dual numbers).
+    /// Default: `None` (such a pair then takes the 4-D paths). With the `closed-form` feature
+    /// (on by default), like the contour form that uses it.
+    #[cfg(feature = "closed-form")]
+    #[inline]
+    fn point_and_partials(&self, t: T, s: T) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {
+        let _ = (t, s);
+        None
+    }
 }
 
 impl<T: Real, S: Surface<T> + ?Sized> Surface<T> for &S {
@@ -139,6 +151,10 @@ impl<T: Real, S: Surface<T> + ?Sized> Surface<T> for &S {
     #[cfg(feature = "closed-form")]
     fn affine_map(&self) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {
         (**self).affine_map()
+    }
+    #[cfg(feature = "closed-form")]
+    fn point_and_partials(&self, t: T, s: T) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {
+        (**self).point_and_partials(t, s)
     }
 }
 
@@ -190,6 +206,17 @@ impl<T: Real, M: ParametricMap<T>> Surface<T> for AutoNormal<M> {
         let n = gt.cross(gs);
         (p, if self.0.flipped() { -n } else { n })
     }
+    #[cfg(feature = "closed-form")]
+    fn point_and_partials(&self, t: T, s: T) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {
+        Some(dual_partials(&self.0, t, s))
+    }
+}
+
+/// g, ∂g/∂t and ∂g/∂s of a [`ParametricMap`] by dual numbers (exact to rounding).
+#[cfg(feature = "closed-form")]
+pub(crate) fn dual_partials<T: Real, M: ParametricMap<T> + ?Sized>(m: &M, t: T, s: T) -> (Vec3<T>, Vec3<T>, Vec3<T>) {
+    let g = m.map(Dual::variable_t(t), Dual::variable_s(s));
+    (vec3(g.x.v, g.y.v, g.z.v), vec3(g.x.dt, g.y.dt, g.z.dt), vec3(g.x.ds, g.y.ds, g.z.ds))
 }
 
 /// Any surface, radiating from its other side (normal negated).
@@ -213,6 +240,10 @@ impl<T: Real, S: Surface<T>> Surface<T> for Flipped<S> {
     #[cfg(feature = "closed-form")]
     fn affine_map(&self) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {
         self.0.affine_map()
+    }
+    #[cfg(feature = "closed-form")]
+    fn point_and_partials(&self, t: T, s: T) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {
+        self.0.point_and_partials(t, s)
     }
 }
 

@@ -96,6 +96,10 @@ impl<T: Real> Surface<T> for Parallelogram<T> {
     fn affine_map(&self) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {
         Some((self.origin, self.edge_t, self.edge_s))
     }
+    #[cfg(feature = "closed-form")]
+    fn point_and_partials(&self, t: T, s: T) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {
+        Some(super::dual_partials(self, t, s))
+    }
 }
 
 #[cfg(test)]

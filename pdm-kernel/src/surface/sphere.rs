@@ -100,6 +100,10 @@ impl<T: Real> Surface<T> for Sphere<T> {
         let n = radial.scale(self.radius * self.radius * sp);
         (p, if self.side == Side::Inner { -n } else { n })
     }
+    #[cfg(feature = "closed-form")]
+    fn point_and_partials(&self, t: T, s: T) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {
+        Some(super::dual_partials(self, t, s))
+    }
 }
 
 #[cfg(test)]
