@@ -232,7 +232,7 @@ where
     let (adjacency, gap) = classify_near(a, b);
     // Two flat patches that see each other wholly: the contour form at two orders.
     #[cfg(feature = "closed-form")]
-    if crate::pair::contour_applies(adjacency, gap) {
+    if crate::pair::contour_applies(adjacency) {
         let lo_order = 8usize.min(settings.max_order);
         // Where the contour terms cancel beyond the working precision (f32 cells close
         // together) or the gap is below the geometry's resolution (`Unresolvable`), the 4-D

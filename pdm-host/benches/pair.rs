@@ -1,0 +1,89 @@
+//! One pair of patches by `pair_exchange`: time per pair and relative error against the
+//! closed form, for the flat pairs the contour form takes and the transform it replaced.
+//!
+//! `cargo bench -p pdm-host --bench pair -- --warm-up-time 1 --measurement-time 3`
+//!
+//! Cases (closed forms from `../shared/REFERENCES.md`):
+//! - `c14`: perpendicular unit squares sharing an edge (C-14, F = 0.2000437760754…): the
+//!   contour form, and the edge transform (`touching_exchange`, 6·p⁴ kernel evaluations) it
+//!   replaced for flat pairs;
+//! - `c11`: parallel unit squares at distance 1 (C-11);
+//! - `c41`: coaxial unit disks 0.01 apart, whole (C-41; cut into 4 × 4 piece pairs, the contour
+//!   form along the curved edges).
+//!
+//! The relative errors are printed once per case before timing. Single-threaded.
+
+#![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
+
+use std::hint::black_box;
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
+use pdm_kernel::{classify_near, pair_exchange, touching_exchange, vec3, Disk, PairSettings, Parallelogram, Patch};
+
+const C14: f64 = 0.200_043_776_075_403_16;
+
+/// C-11: unit squares at distance h.
+fn c11(h: f64) -> f64 {
+    let (x, y) = (1.0 / h, 1.0 / h);
+    let (x2, y2) = (1.0 + x * x, 1.0 + y * y);
+    2.0 / (std::f64::consts::PI * x * y)
+        * ((x2 * y2 / (1.0 + x * x + y * y)).sqrt().ln()
+            + x * y2.sqrt() * (x / y2.sqrt()).atan()
+            + y * x2.sqrt() * (y / x2.sqrt()).atan()
+            - x * x.atan()
+            - y * y.atan())
+}
+
+/// C-41: coaxial disks r1 (emitter), r2 at distance h.
+fn c41(r1: f64, r2: f64, h: f64) -> f64 {
+    let (a, b) = (r1 / h, r2 / h);
+    let x = 1.0 + (1.0 + b * b) / (a * a);
+    0.5 * (x - (x * x - 4.0 * (r2 / r1).powi(2)).sqrt())
+}
+
+fn settings(order: usize) -> PairSettings {
+    PairSettings { order, singular_order: order, boundaries: true }
+}
+
+fn bench_pairs(c: &mut Criterion) {
+    let floor = Parallelogram::new(vec3(0.0, 0.0, 0.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0)).unwrap();
+    let wall = Parallelogram::new(vec3(0.0, 0.0, 0.0), vec3(0.0, 0.0, 1.0), vec3(1.0, 0.0, 0.0)).unwrap();
+    let top = Parallelogram::new(vec3(0.0, 0.0, 1.0), vec3(0.0, 1.0, 0.0), vec3(1.0, 0.0, 0.0)).unwrap();
+    let lower = Disk::new(vec3(0.0, 0.0, 0.0), vec3(0.0, 0.0, 1.0), 1.0).unwrap();
+    let upper = Disk::new(vec3(0.0, 0.0, 0.01), vec3(0.0, 0.0, -1.0), 1.0).unwrap();
+    let (pf, pw, pt) = (Patch::whole(&floor).unwrap(), Patch::whole(&wall).unwrap(), Patch::whole(&top).unwrap());
+    let (pl, pu) = (Patch::whole(&lower).unwrap(), Patch::whole(&upper).unwrap());
+    let (adjacency, gap) = classify_near(&pf, &pw);
+    let disks = std::f64::consts::PI * c41(1.0, 1.0, 0.01);
+    let mut group = c.benchmark_group("pair");
+    for order in [8, 12, 16] {
+        let s = settings(order);
+        let contour = pair_exchange::<f64, _, _, _, 256>(&pf, &pw, s, &()).unwrap();
+        let transform = touching_exchange(&pf, &pw, adjacency, gap, order, &()).unwrap();
+        let parallel = pair_exchange::<f64, _, _, _, 256>(&pf, &pt, s, &()).unwrap();
+        let coaxial = pair_exchange::<f64, _, _, _, 256>(&pl, &pu, s, &()).unwrap();
+        eprintln!(
+            "order {order}: c14 contour {:.1e}, c14 edge transform {:.1e}, c11 {:.1e}, c41 disks at 0.01 {:.1e}",
+            (contour - C14).abs() / C14,
+            (transform - C14).abs() / C14,
+            (parallel - c11(1.0)).abs() / c11(1.0),
+            (coaxial - disks).abs() / disks
+        );
+        group.bench_with_input(BenchmarkId::new("c14/contour", order), &order, |bench, _| {
+            bench.iter(|| pair_exchange::<f64, _, _, _, 256>(black_box(&pf), black_box(&pw), s, &()).unwrap());
+        });
+        group.bench_with_input(BenchmarkId::new("c14/edge-transform", order), &order, |bench, _| {
+            bench.iter(|| touching_exchange(black_box(&pf), black_box(&pw), adjacency, gap, order, &()).unwrap());
+        });
+        group.bench_with_input(BenchmarkId::new("c11/contour", order), &order, |bench, _| {
+            bench.iter(|| pair_exchange::<f64, _, _, _, 256>(black_box(&pf), black_box(&pt), s, &()).unwrap());
+        });
+        group.bench_with_input(BenchmarkId::new("c41-0.01/contour", order), &order, |bench, _| {
+            bench.iter(|| pair_exchange::<f64, _, _, _, 256>(black_box(&pl), black_box(&pu), s, &()).unwrap());
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench_pairs);
+criterion_main!(benches);
