@@ -210,6 +210,51 @@ fn coaxial_flat_pairs_at_every_gap() {
     assert!(worst < 1e-12, "{worst:.2e}");
 }
 
+/// Disk sectors meeting at right angles along a shared radius: the half-disk y ≥ 0 of the
+/// plane z = 0 (radiating +z) and the half-disk z ≥ 0 of the plane y = 0 (radiating +y), and
+/// their quarters x ≥ 0. Both are flat: the contour form along their edges takes them,
+/// exponentially, where the edge transform converges only algebraically at the common centre
+/// (its side collapses there: the half-disks' value approaches the contour's from above, 1.9e-6
+/// off at order 24). Checks: both argument orders at orders 12 and 16 agree with order 24 to
+/// 1e-10 and 1e-13, and
+/// the 4-D path (the same disks behind a wrapper without partial derivatives) at order 24 is
+/// within its own algebraic error (≤ 4e-6) of the value.
+#[test]
+fn perpendicular_disk_sectors_sharing_a_radius() {
+    /// A surface with point and normal only: the 4-D paths take every pair.
+    struct Plain<S>(S);
+    impl<S: Surface<f64>> Surface<f64> for Plain<S> {
+        fn domain(&self) -> ParamRect<f64> {
+            self.0.domain()
+        }
+        fn point(&self, t: f64, s: f64) -> Vec3<f64> {
+            self.0.point(t, s)
+        }
+        fn normal(&self, t: f64, s: f64) -> Vec3<f64> {
+            self.0.normal(t, s)
+        }
+    }
+    let floor = Disk::<f64>::new(v([0.0, 0.0, 0.0]), v([0.0, 0.0, 1.0]), 1.0).unwrap();
+    let wall = Disk::<f64>::new(v([0.0, 0.0, 0.0]), v([0.0, 1.0, 0.0]), 1.0).unwrap();
+    for (a_rect, b_rect) in [((0.0, PI), (PI, 2.0 * PI)), ((0.0, 0.5 * PI), (1.5 * PI, 2.0 * PI))] {
+        let ra = ParamRect::new(0.0, 1.0, a_rect.0, a_rect.1).unwrap();
+        let rb = ParamRect::new(0.0, 1.0, b_rect.0, b_rect.1).unwrap();
+        let (pa, pb) = (Patch::new(&floor, ra).unwrap(), Patch::new(&wall, rb).unwrap());
+        let value = exchange(&pa, &pb, settings(24), &()).unwrap();
+        for (order, allowed) in [(12, 1e-10), (16, 1e-13)] {
+            for (x, y) in [(&pa, &pb), (&pb, &pa)] {
+                let other = exchange(x, y, settings(order), &()).unwrap();
+                assert!(((other - value) / value).abs() < allowed, "order {order}: {other} vs {value}");
+            }
+        }
+        let (plain_floor, plain_wall) = (Plain(floor), Plain(wall));
+        let (qa, qb) = (Patch::new(&plain_floor, ra).unwrap(), Patch::new(&plain_wall, rb).unwrap());
+        let four_d = exchange(&qa, &qb, PairSettings { order: 24, singular_order: 24, boundaries: true }, &()).unwrap();
+        println!("sectors {a_rect:?} / {b_rect:?}: contour {value:.15e}, 4-D {four_d:.15e}");
+        assert!(((four_d - value) / value).abs() < 4e-6, "{four_d} vs {value}");
+    }
+}
+
 /// F3: a floor 1/3 × 1/2 against a wall 1 × 0.35 whose bottom edge contains the floor's edge,
 /// the two sharing one endpoint (a partial shared edge). Reference: C-14 superposition
 /// ([`floor_to_longer_wall`]), 3.219835522191568e-2.
