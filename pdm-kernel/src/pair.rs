@@ -3,18 +3,20 @@
 //! - A patch whose image closes on itself (a whole disk, cylinder, cone or sphere as one
 //!   patch) is first cut at its seam into pieces (`pieces`); every pair of pieces is then
 //!   dispatched as below and the results are summed.
-//! - Touching pairs (shared edge or vertex, found by [`crate::singular::classify_near`], also
-//!   when they are only nearly touching) use the regularising
-//!   transforms of [`crate::singular`], converging exponentially with `singular_order`.
+//! - Two flat patches that see each other wholly, with no occluder able to cut between them,
+//!   use the contour form (`contour.rs`), separate or touching: parallelograms with the inner
+//!   line integral in closed form, flat patches with curved edges (disk and annulus sectors,
+//!   planar Bézier patches, a disk against a parallelogram) with graded rules along both
+//!   edges ([`Surface::point_and_partials`]). Exponential in the order at any gap, from far
+//!   apart down to nearly coincident, along a shared edge (whole or partial) and at a shared
+//!   vertex. Where its terms cancel beyond half the digits (a fold of a degree or less), a
+//!   touching pair falls to the transforms below.
+//! - Other touching pairs (shared edge or vertex, found by
+//!   [`crate::singular::classify_near`], also when they are only nearly touching) use the
+//!   regularising transforms of [`crate::singular`], converging exponentially with
+//!   `singular_order`.
 //! - The same patch twice uses the identical-panel transform of [`crate::singular`],
 //!   converging exponentially with `singular_order` on a smooth patch.
-//! - Two flat patches that see each other wholly, with no occluder able to cut between them
-//!   and not sharing a whole edge in exact contact, use the contour form (`contour.rs`):
-//!   parallelograms with the inner line integral in closed form, flat patches with curved
-//!   edges (disk and annulus sectors, planar Bézier patches, a disk against a parallelogram)
-//!   with graded rules along both edges ([`Surface::point_and_partials`]). Exponential in the
-//!   order at any gap, from far apart down to nearly coincident, and for a partial shared edge
-//!   (a short edge along a longer one from a common corner).
 //! - Other separate pairs use the PDM sum at `order`. With `boundaries` on, a pair that
 //!   straddles a back-face cut, that an occluder may cut, or whose patches are closer than
 //!   their size gets the visibility boundaries placed into the inner rule and the inner patch
