@@ -9,7 +9,7 @@
 //!   planar Bézier patches, a disk against a parallelogram) with graded rules along both
 //!   edges ([`Surface::point_and_partials`]). Exponential in the order at any gap, from far
 //!   apart down to nearly coincident, along a shared edge (whole or partial) and at a shared
-//!   vertex. Where its terms cancel beyond half the digits (a fold of a degree or less), a
+//!   vertex. Where its terms cancel beyond half the digits, a
 //!   touching pair falls to the transforms below.
 //! - Other touching pairs (shared edge or vertex, found by
 //!   [`crate::singular::classify_near`], also when they are only nearly touching) use the
