@@ -242,9 +242,11 @@ where
         // rounding bound in the estimate, and the refusal of an unresolvable gap stands.
         match contour_leaf(a, b, lo_order, settings, occluders) {
             Some(Err(PdmError::Unresolvable))
-                if adjacency != Adjacency::Separate || resolved::<T, SA, SB, CAP>(a, b, settings.max_order)? => {}
+                if adjacency != Adjacency::Separate
+                    || crate::pair::resolved::<T, SA, SB, CAP>(a, b, settings.max_order)? => {}
             Some(Ok((_, true)))
-                if adjacency != Adjacency::Separate || resolved::<T, SA, SB, CAP>(a, b, settings.max_order)? => {}
+                if adjacency != Adjacency::Separate
+                    || crate::pair::resolved::<T, SA, SB, CAP>(a, b, settings.max_order)? => {}
             None => {}
             Some(result) => return result.map(|(estimate, _)| estimate),
         }
@@ -309,25 +311,6 @@ where
         lo = hi;
         order = (order + 8).min(crate::gauss::MAX_ORDER);
     }
-}
-
-/// Whether the Gauss rules of order `order` resolve the pair
-/// ([`crate::form_factor::samples_resolved`]).
-#[cfg(feature = "closed-form")]
-#[inline(never)]
-fn resolved<T, SA, SB, const CAP: usize>(
-    a: &Patch<'_, T, SA>,
-    b: &Patch<'_, T, SB>,
-    order: usize,
-) -> Result<bool, PdmError>
-where
-    T: Real,
-    SA: Surface<T> + ?Sized,
-    SB: Surface<T> + ?Sized,
-{
-    let sa = PatchSamples::<T, CAP>::new(a, order)?;
-    let sb = PatchSamples::<T, CAP>::new(b, order)?;
-    Ok(crate::form_factor::samples_resolved(&sa, order, &sb, order))
 }
 
 /// The same patch twice by the identical-panel transform

@@ -73,6 +73,13 @@ pub(crate) fn form_factor<T: Real>(value: T) -> Result<T, PdmError> {
     exchange(value, T::ONE, T::ONE)
 }
 
+/// Whether a value was summed from terms over a thousand times larger: its rounding bound
+/// (8 ε × the terms' magnitude) above 8000 ε of it. The quadrature error of the terms is then
+/// amplified as much (the contour form on flat patches side by side, nearly in one plane).
+pub(crate) fn cancels<T: Real>(value: T, rounding: T) -> bool {
+    rounding > T::from_f64(8000.0) * T::EPSILON * value.abs()
+}
+
 /// Whether a value has lost more than half its digits to cancellation: its rounding bound
 /// above √ε of it (1.5e-8 in f64). The contour form's terms cancel so on long thin strips
 /// close together.

@@ -268,6 +268,15 @@ where
             // below the geometry's resolution: the transforms below take it.
             Some(Err(PdmError::Unresolvable)) if adjacency != Adjacency::Separate => {}
             Some(Ok((v, _, r))) if adjacency != Adjacency::Separate && crate::bounds::lost_digits(v, r) => {}
+            // A separate pair whose value is far below its contour terms (flat patches side by
+            // side, nearly in one plane: the terms' quadrature error is amplified as much):
+            // the 4-D paths below take it where their rules resolve it; otherwise the contour
+            // value goes on with its rounding bound, which the whole pair's check refuses if it
+            // lost half the digits.
+            Some(Ok((v, _, r)))
+                if adjacency == Adjacency::Separate
+                    && crate::bounds::cancels(v, r)
+                    && resolved::<T, SA, SB, CAP>(a, b, settings.order)? => {}
             Some(result) => return result,
             None => {}
         }
@@ -311,6 +320,24 @@ where
             }
         }
     }
+}
+
+/// Whether the Gauss rules of order `order` resolve the pair
+/// ([`crate::form_factor::samples_resolved`]).
+#[cfg(feature = "closed-form")]
+pub(crate) fn resolved<T, SA, SB, const CAP: usize>(
+    a: &Patch<'_, T, SA>,
+    b: &Patch<'_, T, SB>,
+    order: usize,
+) -> Result<bool, PdmError>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+{
+    let sa = PatchSamples::<T, CAP>::new(a, order)?;
+    let sb = PatchSamples::<T, CAP>::new(b, order)?;
+    Ok(crate::form_factor::samples_resolved(&sa, order, &sb, order))
 }
 
 /// Which patch of a separate, unoccluded pair the boundary path should integrate outside

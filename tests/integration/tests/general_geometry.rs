@@ -210,6 +210,39 @@ fn coaxial_flat_pairs_at_every_gap() {
     assert!(worst < 1e-12, "{worst:.2e}");
 }
 
+/// Flat patches side by side, nearly in one plane: unit squares facing each other across a
+/// lateral gap of ½ at heights 1e-2 … 1e-4, and unit disks 0.5 apart at the rims. The value is
+/// small (down to 1e-9) while the contour form's terms are O(1): they cancel beyond half the
+/// digits, so the pair falls to the 4-D paths, whose rules resolve it (once
+/// `Err(Unresolvable)`). Squares: C-11 algebra ([`parallel_offset`]), whose own terms cancel
+/// too — allowed 64 ε × Σ|terms| / value. Disks: both argument orders and orders 12 / 16 agree
+/// to 1e-7 (the squares bound the method's accuracy in this configuration).
+#[test]
+fn flat_pairs_side_by_side_nearly_coplanar() {
+    for h in [1e-2, 1e-3, 1e-4] {
+        let lower = square::<f64>([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]);
+        let upper = square::<f64>([1.5, 0.0, h], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]);
+        let reference = parallel_offset([0.0, 1.0], [0.0, 1.0], [1.5, 2.5], [0.0, 1.0], h);
+        // Σ|terms| of the algebra: the largest is L·M·C-11 ≤ L·M with L ≤ 2.5, M ≤ 1.
+        let conditioning = 64.0 * f64::EPSILON * 16.0 * 2.5 / reference;
+        let (ab, ba) = both_orders(&lower, &upper, settings(16), reference);
+        let allowed = 1e-8 + conditioning;
+        assert!(
+            rel(&ab, reference) < allowed && rel(&ba, reference) < allowed,
+            "h {h}: {ab:?} / {ba:?} vs {reference} (allowed {allowed:.1e})"
+        );
+        let lower = Disk::<f64>::new(v([0.0, 0.0, 0.0]), v([0.0, 0.0, 1.0]), 1.0).unwrap();
+        let upper = Disk::<f64>::new(v([2.5, 0.0, h]), v([0.0, 0.0, -1.0]), 1.0).unwrap();
+        let (pa, pb) = (Patch::whole(&lower).unwrap(), Patch::whole(&upper).unwrap());
+        let value = exchange(&pa, &pb, settings(16), &()).unwrap();
+        for (x, y, order) in [(&pa, &pb, 12), (&pb, &pa, 16)] {
+            let other = exchange(x, y, settings(order), &()).unwrap();
+            println!("disks 0.5 apart at {h:e}: {value:.12e}, order {order}: {:.1e}", (other - value).abs() / value);
+            assert!(((other - value) / value).abs() < 1e-7, "h {h}: {other} vs {value}");
+        }
+    }
+}
+
 /// Disk sectors meeting at right angles along a shared radius: the half-disk y ≥ 0 of the
 /// plane z = 0 (radiating +z) and the half-disk z ≥ 0 of the plane y = 0 (radiating +y), and
 /// their quarters x ≥ 0. Both are flat: the contour form along their edges takes them,
