@@ -450,10 +450,11 @@ fn slope_root<T: Real>(f: &impl Fn(T) -> (T, T), a: (T, T), b: (T, T)) -> (T, T,
     (last.0, last.1, evaluations)
 }
 
-/// Local minima at most refined per edge pair where one edge passes close over the other.
-const MAX_CROSSINGS: usize = 3;
+/// Cuts at most per edge pair where one edge passes close over the other (two per sampled
+/// local minimum of the distance).
+const MAX_CROSSINGS: usize = 6;
 /// Samples of the distance between two edges along the outer one.
-const CROSSING_SAMPLES: usize = 16;
+const CROSSING_SAMPLES: usize = 64;
 
 /// A_a·F_{a→b}, the evaluations and a bound on the value's rounding error for two flat patches
 /// with curved edges ([`Outline`]), each wholly in front of (or on) the other's plane, no
@@ -462,7 +463,7 @@ const CROSSING_SAMPLES: usize = 16;
 /// the edge's point nearest to x and graded geometrically towards it and towards the ends, down
 /// to the distance of x from them, which makes the inner rule exponential at every gap; the
 /// outer rule is cut where the outer edge passes nearest to the inner edge's ends and where it
-/// comes closest to the inner edge (up to three such places), graded the same way. The rounding
+/// comes closest to the inner edge (up to six such places, both halves of each sampled minimum searched), graded the same way. The rounding
 /// is bounded and refused as in [`quad_exchange`].
 pub(crate) fn curve_exchange<T, SA, SB>(
     a: &Outline<'_, T, SA>,
@@ -568,11 +569,18 @@ fn curve_pair<T: Real>(
     for k in 0..=CROSSING_SAMPLES {
         let (before, after) = (k.saturating_sub(1), (k + 1).min(CROSSING_SAMPLES));
         let (Some(&below), Some(&here), Some(&above)) = (d2.get(before), d2.get(k), d2.get(after)) else { continue };
-        if found < MAX_CROSSINGS && here <= below && here <= above && here < largest * T::HALF * T::HALF {
+        if found + 2 <= MAX_CROSSINGS && here <= below && here <= above && here < largest * T::HALF * T::HALF {
+            // Each half of the bracket on its own: an edge that clips a shallow cap off a
+            // curved one crosses it twice within a sample spacing, and both need a cut.
             let step = T::ONE / T::from_usize(CROSSING_SAMPLES);
-            let (s, _, _) = minimise(&gap, step * T::from_usize(before), step * T::from_usize(after));
-            add(s);
-            found += 1;
+            let (lo, mid, hi) = (step * T::from_usize(before), step * T::from_usize(k), step * T::from_usize(after));
+            let (left, _, _) = minimise(&gap, lo, mid);
+            let (right, _, _) = minimise(&gap, mid, hi);
+            add(left);
+            if right != left {
+                add(right);
+            }
+            found += 2;
         }
     }
     let used = cuts.get_mut(..nc).unwrap_or_default();

@@ -243,6 +243,31 @@ fn flat_pairs_side_by_side_nearly_coplanar() {
     }
 }
 
+/// A square's edge clipping a shallow cap (depth 1e-3, 3e-4, 1e-4) off a unit disk's rim, 1e-6
+/// above it (found by a red-team pass: the edge crosses the rim twice within one sample
+/// spacing of the crossing search, which cut only one of them: 4.7e-3 and 5.7e-4 off by
+/// argument order at order 16, and the tolerance mode's estimate below its error). Checks:
+/// both argument orders at order 16 agree with order 24 to 1e-8, and the tolerance mode's
+/// estimate at 1e-3 bounds its distance from the order-24 value.
+#[test]
+fn square_edge_clipping_a_shallow_cap_off_a_disk() {
+    let half = core::f64::consts::FRAC_1_SQRT_2;
+    let disk = Disk::<f64>::new(v([0.0, 0.0, 0.0]), v([0.0, 0.0, 1.0]), 1.0).unwrap();
+    for depth in [1e-3, 3e-4, 1e-4] {
+        let d = 1.0 - depth;
+        let plate =
+            square::<f64>([d * half + 0.5 * half, d * half - 0.5 * half, 1e-6], [-half, half, 0.0], [half, half, 0.0]);
+        let (pa, pb) = (Patch::whole(&disk).unwrap(), Patch::whole(&plate).unwrap());
+        let value = exchange(&pa, &pb, settings(24), &()).unwrap();
+        for other in [exchange(&pa, &pb, settings(16), &()).unwrap(), exchange(&pb, &pa, settings(16), &()).unwrap()] {
+            println!("cap depth {depth:e}: {value:.12e}, order 16: {:.1e}", (other - value).abs() / value);
+            assert!(((other - value) / value).abs() < 1e-8, "depth {depth}: {other} vs {value}");
+        }
+        let e = adaptive_exchange::<f64, _, _, _, 256>(&pa, &pb, Adaptive::new(1e-3), &()).unwrap();
+        assert!(e.error >= (e.value - value).abs(), "depth {depth}: {e:?} vs {value}");
+    }
+}
+
 /// Disk sectors meeting at right angles along a shared radius: the half-disk y ≥ 0 of the
 /// plane z = 0 (radiating +z) and the half-disk z ≥ 0 of the plane y = 0 (radiating +y), and
 /// their quarters x ≥ 0. Both are flat: the contour form along their edges takes them,
