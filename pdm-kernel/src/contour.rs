@@ -282,17 +282,31 @@ const FLAT_GRID: usize = 7;
 impl<'p, T: Real, S: Surface<T> + ?Sized> Outline<'p, T, S> {
     /// The outline of a flat patch whose surface gives its partial derivatives
     /// ([`Surface::point_and_partials`]); `None` if it gives none or the patch is not flat: its
-    /// points on a 7 × 7 grid (edges included) within 64 ε of its size from the plane through its
-    /// centre, its unit normals there (where not zero) within 64 ε of the centre's.
+    /// points on a 7 × 7 grid (edges included, interior nodes off the rational fractions)
+    /// within 64 ε of its size from the plane through its centre, its unit normals there (where
+    /// not zero) within 64 ε of the centre's. A sampled test: a map bent only between the nodes
+    /// would pass it.
     pub(crate) fn new(p: &Patch<'p, T, S>) -> Option<Self> {
         let (surface, rect) = (p.surface(), p.rect());
         let (tm, sm) = ((rect.t0 + rect.t1) * T::HALF, (rect.s0 + rect.s1) * T::HALF);
         let (origin, gt, gs) = surface.point_and_partials(tm, sm)?;
         let normal = unit(surface.normal(tm, sm))?;
         let sign = if normal.dot(gt.cross(gs)) >= T::ZERO { T::ONE } else { -T::ONE };
+        // The sides' ends, and interior points shifted off the rational fractions by the
+        // golden ratio's fractional parts: a bump that vanishes with zero slope on a uniform
+        // grid (sin² 6πt) would pass a uniform test.
+        let node = |i: usize| {
+            let uniform = T::from_usize(i) / T::from_usize(FLAT_GRID - 1);
+            if i == 0 || i + 1 == FLAT_GRID {
+                uniform
+            } else {
+                #[allow(clippy::cast_precision_loss)]
+                let golden = (i as f64 * 0.618_033_988_749_895) % 1.0;
+                uniform + T::from_f64(golden - 0.5) / T::from_usize(2 * (FLAT_GRID - 1))
+            }
+        };
         let at = |i: usize, j: usize| {
-            let x = T::from_usize(i) / T::from_usize(FLAT_GRID - 1);
-            let y = T::from_usize(j) / T::from_usize(FLAT_GRID - 1);
+            let (x, y) = (node(i), node(j));
             surface.point_and_normal(rect.t0 + (rect.t1 - rect.t0) * x, rect.s0 + (rect.s1 - rect.s0) * y)
         };
         let mut size = T::ZERO;
@@ -738,5 +752,19 @@ mod tests {
         }
         let bent = BezierPatch::new(control).unwrap();
         assert!(Outline::new(&Patch::whole(&bent).unwrap()).is_none());
+        // Bumps that vanish with zero slope at t, s = k/6: a uniform 7 × 7 grid sees a plane.
+        struct Bumps;
+        impl crate::surface::ParametricMap<f64> for Bumps {
+            fn domain(&self) -> ParamRect<f64> {
+                ParamRect { t0: 0.0, t1: 1.0, s0: 0.0, s1: 1.0 }
+            }
+            fn map<S: crate::dual::Scalar<f64>>(&self, t: S, s: S) -> crate::vec3::Vec3<S> {
+                let six_pi = S::constant(6.0 * core::f64::consts::PI);
+                let (a, b) = ((t * six_pi).sin(), (s * six_pi).sin());
+                vec3(t, s, S::constant(0.05) - S::constant(0.1) * a * a * b * b)
+            }
+        }
+        let bumps = crate::surface::AutoNormal(Bumps);
+        assert!(Outline::new(&Patch::whole(&bumps).unwrap()).is_none());
     }
 }
