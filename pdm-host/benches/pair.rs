@@ -3,7 +3,7 @@
 //!
 //! `cargo bench -p pdm-host --bench pair -- --warm-up-time 1 --measurement-time 3`
 //!
-//! Cases (closed forms from `../shared/REFERENCES.md`):
+//! Cases (closed forms from `pdm_host::reference::closed_form`, `../shared/REFERENCES.md`):
 //! - `c14`: perpendicular unit squares sharing an edge (C-14, F = 0.2000437760754…): the
 //!   contour form, and the edge transform (`touching_exchange`, 6·p⁴ kernel evaluations) it
 //!   replaced for flat pairs;
@@ -18,28 +18,10 @@
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
+use pdm_host::reference::closed_form::{coaxial_disks, parallel_rectangles};
 use pdm_kernel::{classify_near, pair_exchange, touching_exchange, vec3, Disk, PairSettings, Parallelogram, Patch};
 
 const C14: f64 = 0.200_043_776_075_403_16;
-
-/// C-11: unit squares at distance h.
-fn c11(h: f64) -> f64 {
-    let (x, y) = (1.0 / h, 1.0 / h);
-    let (x2, y2) = (1.0 + x * x, 1.0 + y * y);
-    2.0 / (std::f64::consts::PI * x * y)
-        * ((x2 * y2 / (1.0 + x * x + y * y)).sqrt().ln()
-            + x * y2.sqrt() * (x / y2.sqrt()).atan()
-            + y * x2.sqrt() * (y / x2.sqrt()).atan()
-            - x * x.atan()
-            - y * y.atan())
-}
-
-/// C-41: coaxial disks r1 (emitter), r2 at distance h.
-fn c41(r1: f64, r2: f64, h: f64) -> f64 {
-    let (a, b) = (r1 / h, r2 / h);
-    let x = 1.0 + (1.0 + b * b) / (a * a);
-    0.5 * (x - (x * x - 4.0 * (r2 / r1).powi(2)).sqrt())
-}
 
 fn settings(order: usize) -> PairSettings {
     PairSettings { order, singular_order: order, boundaries: true }
@@ -54,7 +36,8 @@ fn bench_pairs(c: &mut Criterion) {
     let (pf, pw, pt) = (Patch::whole(&floor).unwrap(), Patch::whole(&wall).unwrap(), Patch::whole(&top).unwrap());
     let (pl, pu) = (Patch::whole(&lower).unwrap(), Patch::whole(&upper).unwrap());
     let (adjacency, gap) = classify_near(&pf, &pw);
-    let disks = std::f64::consts::PI * c41(1.0, 1.0, 0.01);
+    let disks = std::f64::consts::PI * coaxial_disks(1.0, 1.0, 0.01);
+    let c11 = parallel_rectangles(1.0, 1.0, 1.0);
     let mut group = c.benchmark_group("pair");
     for order in [8, 12, 16] {
         let s = settings(order);
@@ -66,7 +49,7 @@ fn bench_pairs(c: &mut Criterion) {
             "order {order}: c14 contour {:.1e}, c14 edge transform {:.1e}, c11 {:.1e}, c41 disks at 0.01 {:.1e}",
             (contour - C14).abs() / C14,
             (transform - C14).abs() / C14,
-            (parallel - c11(1.0)).abs() / c11(1.0),
+            (parallel - c11).abs() / c11,
             (coaxial - disks).abs() / disks
         );
         group.bench_with_input(BenchmarkId::new("c14/contour", order), &order, |bench, _| {
