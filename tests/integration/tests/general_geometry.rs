@@ -499,7 +499,20 @@ fn f4_user_map_square_sharing_an_edge() {
 /// the shadow).
 #[test]
 fn f10_box_floor_row_with_a_sphere_inside() {
-    let (centre, radius) = ([0.7, 0.6, 0.45], 0.3);
+    box_floor_row([0.7, 0.6, 0.45], 0.3, 16, false);
+}
+
+/// F10 with another sphere (R = 0.22 at (1.45, 1.05, 0.4): nearer the corner x = 2, y = 1.5)
+/// at order 12, each face integrated outside (the other argument order).
+#[test]
+fn f10_box_floor_row_other_sphere_reversed() {
+    box_floor_row([1.45, 1.05, 0.4], 0.22, 12, true);
+}
+
+/// The floor's row of the F10 box with a sphere (`centre`, `radius`) inside as occluder, by
+/// `pair_exchange` at `order` (floor outside, or each face outside if `reversed`), against
+/// the row-sum reference of [`f10_box_floor_row_with_a_sphere_inside`] to 1e-5.
+fn box_floor_row(centre: [f64; 3], radius: f64, order: usize, reversed: bool) {
     let sphere = Sphere::<f64>::outer(v(centre), radius).unwrap();
     let floor = square::<f64>([0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 1.5, 0.0]);
     let others = [
@@ -515,7 +528,12 @@ fn f10_box_floor_row_with_a_sphere_inside() {
     let pf = Patch::whole(&floor).unwrap();
     let mut total = Ok(0.0);
     for (name, face) in &others {
-        let x = exchange(&pf, &Patch::whole(face).unwrap(), settings(16), &sphere);
+        let pface = Patch::whole(face).unwrap();
+        let x = if reversed {
+            exchange(&pface, &pf, settings(order), &sphere)
+        } else {
+            exchange(&pf, &pface, settings(order), &sphere)
+        };
         println!("floor -> {name}: {}", show(&x));
         total = total.and_then(|t| x.map(|x| t + x));
     }
