@@ -250,8 +250,8 @@ pub(crate) fn pieces<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>) -> (u
     (m, n)
 }
 
-/// Most successive 2 × 2 × 2 × 2 splits of a touching pair that an occluder may cut
-/// ([`split_occluded_contacts`]).
+/// Most successive 2 × 2 × 2 × 2 splits of a touching pair that an occluder may cut, before
+/// the touching transforms take the remaining cells along the contact (module docs).
 pub const MAX_CONTACT_SPLITS: u32 = 4;
 
 /// One piece pair, with touching pairs that an occluder may cut split first: the touching
