@@ -144,7 +144,8 @@ fn tolerance_mode_meets_its_tolerance_on_the_empty_cube() {
 /// error of the 21 factors (86-patch start, tolerance 1e-4: measured actual 1.7e-6, estimate
 /// 9.8e-5).
 #[test]
-fn tolerance_mode_estimate_bounds_the_errors_with_the_sphere() {
+#[ignore = "slow (about 40 s alone): .ci/run runs it, `-- --ignored slow_`"]
+fn slow_tolerance_mode_estimate_bounds_the_errors_with_the_sphere() {
     let j = validate_json(&["--tolerance", "1e-4", "--patches", "86"]);
     let estimate = j["estimated_error"].as_f64().expect("estimated_error in tolerance mode");
     let mut worst: f64 = 0.0;
@@ -257,7 +258,8 @@ fn bad_input_is_one_line_naming_the_value() {
 /// rayon's 2 MiB worker stacks; the workers now get stacks sized for the capacity
 /// (`pdm_host::validate::stack`). Also in debug builds.
 #[test]
-fn largest_capacity_in_tolerance_mode_does_not_overflow() {
+#[ignore = "slow (about 25 s alone): .ci/run runs it, `-- --ignored slow_`"]
+fn slow_largest_capacity_in_tolerance_mode_does_not_overflow() {
     let j = validate_json(&["--tolerance", "1e-3", "--order", "28"]);
     let s2f = numbers(&j["sphere_to_face"], 6);
     assert!(s2f.iter().all(|f| (f - 1.0 / 6.0).abs() < 1e-3), "{s2f:?}");

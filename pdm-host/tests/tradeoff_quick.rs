@@ -31,7 +31,8 @@ fn read(path: &Path) -> String {
 }
 
 #[test]
-fn quick_sweep_writes_csv_svg_and_tables() {
+#[ignore = "slow (about 30 s alone): .ci/run runs it, `-- --ignored slow_`"]
+fn slow_quick_sweep_writes_csv_svg_and_tables() {
     let dir = temp_dir("quick");
     let out = dir.to_str().unwrap();
     let start = std::time::Instant::now();

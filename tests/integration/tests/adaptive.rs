@@ -129,7 +129,8 @@ fn fewer_evaluations_than_uniform_refinement_for_the_same_error() {
 }
 
 #[test]
-fn sphere_to_face_pairs_with_an_honest_estimate() {
+#[ignore = "slow (about 50 s alone): .ci/run runs it, `-- --ignored slow_`"]
+fn slow_sphere_to_face_pairs_with_an_honest_estimate() {
     // Curved pairs straddling the terminator (visibility boundaries placed into the rule).
     let sphere = Sphere::outer(vec3(0.0, 0.0, 0.0), 1.0).unwrap();
     let floor = square([-3.0, -3.0, -3.0], [6.0, 0.0, 0.0], [0.0, 6.0, 0.0]);
@@ -384,7 +385,8 @@ fn tolerance_sweep<SA: Surface<f64>, SB: Surface<f64>, O: Occluder<f64>>(
 }
 
 #[test]
-fn cylinder_between_parallel_squares() {
+#[ignore = "slow (about 20 s alone): .ci/run runs it, `-- --ignored slow_`"]
+fn slow_cylinder_between_parallel_squares() {
     // Unit squares at z = 0 and 1 with a long tube (radius 0.25, axis along y) between them:
     // no closed-form polynomials, the inner rule brackets and bisects; the outer integrand has
     // kinks where the shadow's edges cross the receiver's. The estimate used to be below the
@@ -407,7 +409,8 @@ fn tubes(small: f64) -> (Cylinder<f64>, Cylinder<f64>) {
 }
 
 #[test]
-fn wall_pair_inside_a_tube_around_a_coaxial_tube() {
+#[ignore = "slow (about 45 s alone): .ci/run runs it, `-- --ignored slow_`"]
+fn slow_wall_pair_inside_a_tube_around_a_coaxial_tube() {
     // Two quarter walls of the inside of a tube (radius 1, height 1), a coaxial tube of radius
     // 0.5 occluding.
     let (outer, inner) = tubes(0.5);
@@ -419,7 +422,8 @@ fn wall_pair_inside_a_tube_around_a_coaxial_tube() {
 }
 
 #[test]
-fn self_pair_inside_a_tube() {
+#[ignore = "slow (about 30 s alone): .ci/run runs it, `-- --ignored slow_`"]
+fn slow_self_pair_inside_a_tube() {
     // The inside of a tube against itself (the `Identical` path: the patch is cut at its seams
     // into four pieces, each piece against itself by the identical-panel transform), with and
     // without a coaxial tube occluding. With an occluder that may cut the view, the self pairs
@@ -497,7 +501,8 @@ fn limits_are_reported_as_not_converged() {
 }
 
 #[test]
-fn sphere_to_coaxial_disk() {
+#[ignore = "slow (about 120 s alone): .ci/run runs it, `-- --ignored slow_`"]
+fn slow_sphere_to_coaxial_disk() {
     // Sphere of radius 0.5 centred at distance 1 above a disk of radius 1 facing it:
     // F_sphere→disk = ½ (1 − 1/√(1 + (a/h)²)) (sphere to coaxial disk, Howell's catalogue).
     let sphere = Sphere::outer(vec3(0.0, 0.0, 1.0), 0.5).unwrap();

@@ -187,7 +187,8 @@ fn f2_large_disks_at_a_small_gap() {
 /// r ∈ [0.3, r₁] against the same upper disk (C-41 algebra: the difference of two coaxial-disk
 /// pairs). Both argument orders, f64 at order 16, and the tolerance mode at 1e-10.
 #[test]
-fn coaxial_flat_pairs_at_every_gap() {
+#[ignore = "slow (about 40 s alone): .ci/run runs it, `-- --ignored slow_`"]
+fn slow_coaxial_flat_pairs_at_every_gap() {
     let mut worst: f64 = 0.0;
     for (r1, r2) in [(1.0, 1.0), (1.0, 0.6), (0.7, 1.3)] {
         for h in [2.0, 0.5, 0.1, 1e-2, 1e-4, 1e-6] {
@@ -424,7 +425,8 @@ fn self_pair<S64: Surface<f64>, S32: Surface<f32>>(
 /// must say so, with an estimate above the error. References from the enclosure sum rule on C-41: the wall sees
 /// itself and its end disks, A_w·F_ww = A_w − Σ A_disk·(1 − F_disk→other disk).
 #[test]
-fn f7_tube_frustum_and_cone_walls_against_themselves() {
+#[ignore = "slow (about 60 s alone): .ci/run runs it, `-- --ignored slow_`"]
+fn slow_f7_tube_frustum_and_cone_walls_against_themselves() {
     let walls = |rb: f64, rt: f64, h: f64| {
         let wall = PI * (rb + rt) * ((rb - rt) * (rb - rt) + h * h).sqrt();
         let (ab, at) = (PI * rb * rb, PI * rt * rt);

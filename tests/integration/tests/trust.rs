@@ -111,7 +111,8 @@ fn enclosure_walls_as_occluders() {
 /// A sphere just above a plate: the shadow and the terminator crowd the plate's lines.
 /// Reference: the sphere → rectangle solid-angle form (`sphere_to_polygon`).
 #[test]
-fn sphere_just_above_a_plate() {
+#[ignore = "slow (about 15 s alone): .ci/run runs it, `-- --ignored slow_`"]
+fn slow_sphere_just_above_a_plate() {
     for gap in [1e-1, 1e-2, 1e-5, 1e-8] {
         let sphere = Sphere::<f64>::outer(v([0.0, 0.0, 1.0 + gap]), 1.0).unwrap();
         let plate = square([-2.0, -2.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]);
@@ -372,7 +373,8 @@ fn f32_facing_plates_below_the_resolution() {
 /// `Err(InvalidResult)`; an overshoot within 1e-4 is quadrature error and the bound is
 /// returned.
 #[test]
-fn concentric_spheres_value_at_the_bound() {
+#[ignore = "slow (about 25 s alone): .ci/run runs it, `-- --ignored slow_`"]
+fn slow_concentric_spheres_value_at_the_bound() {
     let inner = Sphere::<f64>::outer(v([0.0, 0.0, 0.0]), 0.5).unwrap();
     let outer = Sphere::<f64>::inner(v([0.0, 0.0, 0.0]), 1.3).unwrap();
     let (a, b) = (Patch::whole(&inner).unwrap(), Patch::whole(&outer).unwrap());
