@@ -1,4 +1,4 @@
-//! The full validation computation (`pdm validate`, both parts: sphere → face and face → face
+//! The full validation computation (`pdm-ff validate`, both parts: sphere → face and face → face
 //! with the sphere as occluder), through `pdm_host::validate::run`, on all cores (rayon over
 //! patch pairs; the kernel is single-threaded).
 //!
@@ -8,9 +8,9 @@
 //!   paper mode, order 5 — the target is < 0.1 s;
 //! * `paper_86_f64`: the 86-patch discretisation (sphere 4 × 8, faces 3 × 3);
 //! * `accurate_280_p5_f64`: accurate mode at the "1e-6 in < 1 s" target's setting
-//!   (`pdm validate --mode accurate --patches 280 --order 5 --singular-order 8`: every value
+//!   (`pdm-ff validate --mode accurate --patches 280 --order 5 --singular-order 8`: every value
 //!   within 7.0e-7 of the references);
-//! * `accurate_280_p8_f64`: accurate mode as `pdm validate --mode accurate` runs it by default
+//! * `accurate_280_p8_f64`: accurate mode as `pdm-ff validate --mode accurate` runs it by default
 //!   (280 patches, order 8, singular order 12: within 6.5e-8).
 
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]

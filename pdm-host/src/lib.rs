@@ -1,4 +1,4 @@
-//! Host-side (std) tools around `pdm-kernel`: the `pdm` command line, independent reference
+//! Host-side (std) tools around `pdm-kernel`: the `pdm-ff` command line, independent reference
 //! values, the Gauss–Legendre table generator, validation and sweeps.
 
 pub mod gauss_gen;

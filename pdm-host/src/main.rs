@@ -1,4 +1,4 @@
-//! The `pdm` command line. `pdm validate --help` for the paper's validation.
+//! The `pdm-ff` command line. `pdm-ff validate --help` for the paper's validation.
 
 mod cli;
 

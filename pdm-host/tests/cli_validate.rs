@@ -1,4 +1,4 @@
-//! `pdm validate` end to end: the JSON contract, bad input, and real checks of the kernel
+//! `pdm-ff validate` end to end: the JSON contract, bad input, and real checks of the kernel
 //! (the empty cube against C-11/C-14, the paper's grid against 1/6).
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
 
@@ -12,7 +12,7 @@ const C11: f64 = 0.1998248956983874; // Howell C-11, unit squares at distance 1
 const C14: f64 = 0.2000437760754032; // Howell C-14, unit squares with a common edge
 
 fn pdm(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_pdm")).args(args).output().expect("run pdm")
+    Command::new(env!("CARGO_BIN_EXE_pdm-ff")).args(args).output().expect("run pdm-ff")
 }
 
 fn validate_json(args: &[&str]) -> Value {

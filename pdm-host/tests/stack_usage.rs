@@ -103,7 +103,7 @@ impl Probe {
 }
 
 /// The workload at capacity `CAP`: the order is the largest with order² ≤ CAP (the adaptive
-/// mode: max_order 12 as in `pdm validate`, tolerance far below reach so every level splits).
+/// mode: max_order 12 as in `pdm-ff validate`, tolerance far below reach so every level splits).
 fn workload<T: Real, const CAP: usize>(entry: Entry, depth: u32) {
     let order = (1..=MAX_ORDER).take_while(|p| p * p <= CAP).last().unwrap();
     let scene = Scene::<T>::new(1.0).unwrap();

@@ -1,4 +1,4 @@
-//! `pdm tradeoff --quick` end to end: files, columns, rows, and the expected behaviour of the
+//! `pdm-ff tradeoff --quick` end to end: files, columns, rows, and the expected behaviour of the
 //! numbers (errors fall with the order on an easy pair, the polygon floors fall with the facet
 //! count, the accurate methods beat the paper's on the shared edge), and `--append`.
 

@@ -37,7 +37,7 @@
 //!   (host, release, f32 CAP 1024: 1.4 MiB), linear in the depth.
 //!
 //! Debug builds need about 3.7× these. Give a thread that runs the tolerance mode at a large
-//! capacity a stack to match (`std::thread::Builder::stack_size`); the `pdm` command does.
+//! capacity a stack to match (`std::thread::Builder::stack_size`); the `pdm-ff` command does.
 //!
 //! Modules: [`gauss`] (tables), [`surface`] (surfaces and normals), [`patch`] (patches, grids,
 //! areas), [`samples`] (precomputed Gauss samples), [`visibility`] (curvature and occlusion
@@ -76,6 +76,11 @@ pub mod singular;
 pub mod surface;
 pub mod vec3;
 pub mod visibility;
+
+/// The crate README's examples, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;
 
 pub use adaptive::{adaptive_exchange, Adaptive, Estimate};
 pub use boundary::{boundary_exchange, boundary_exchange_counted};

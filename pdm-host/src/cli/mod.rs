@@ -16,7 +16,7 @@ const EXIT_FAILURE: u8 = 1;
 
 #[derive(Parser, Debug)]
 #[command(
-    name = "pdm",
+    name = "pdm-ff",
     version,
     about = "Radiosity form factors between curved parametric surfaces (Parametric Differential Method)"
 )]

@@ -256,7 +256,7 @@ pub fn measure<T: Real>(case: CaseId, method: Method, grid_spec: Grid, repeats: 
             let patches = m * n + 6 * k * k;
             let (solution, seconds) = if case == CaseId::SceneSphereFace {
                 // No occluder: the convex sphere's only visibility test is the curvature test
-                // (as in `pdm validate`).
+                // (as in `pdm-ff validate`).
                 let problem = Problem {
                     a_groups: vec![grid(&sphere, m, n)?],
                     b_groups: faces,
@@ -409,7 +409,7 @@ mod tests {
         }
     }
 
-    /// Paper mode on the scene equals `pdm validate --mode paper` (same sums, same order of
+    /// Paper mode on the scene equals `pdm-ff validate --mode paper` (same sums, same order of
     /// addition up to the grouping of partial sums).
     #[test]
     fn scene_paper_mode_matches_validate() {

@@ -1,4 +1,4 @@
-//! `pdm tradeoff`: accuracy against cost. Sweeps Gauss order, subdivision, precision and mode on
+//! `pdm-ff tradeoff`: accuracy against cost. Sweeps Gauss order, subdivision, precision and mode on
 //! the paper's scene and on catalogue pairs, measuring for each point the relative error against
 //! an exact or independent reference, the kernel evaluations and the wall time (median of
 //! repeats); writes a CSV, an error-against-time SVG (log–log, Pareto front marked) and the
@@ -27,7 +27,7 @@
 //! (`adaptive_exchange` at tolerances 1e-1 … 1e-12; f32 stops at 1e-6).
 //!
 //! **Timing.** Catalogue pairs run on one thread; the scene cases run on all cores (rayon over
-//! patch pairs, as `pdm validate`), the kernel itself single-threaded. A point is repeated
+//! patch pairs, as `pdm-ff validate`), the kernel itself single-threaded. A point is repeated
 //! `--repeats` times (once if it takes over a second) and its median time recorded; a series
 //! stops after a point slower than the series budget (20 s, 2 s with `--quick`).
 
@@ -59,7 +59,7 @@ pub enum PrecisionArg {
     F32,
 }
 
-/// Options of `pdm tradeoff`.
+/// Options of `pdm-ff tradeoff`.
 #[derive(Args, Debug, Clone)]
 #[command(after_help = "Merging the micromath rows: run once normally, then\n  \
 cargo run --release -p pdm-host --features micromath -- tradeoff --append\n\
@@ -138,7 +138,7 @@ fn write(path: &Path, text: &str) -> Result<(), String> {
     std::fs::write(path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))
 }
 
-/// Runs `pdm tradeoff` (see the module docs): sweeps, writes the files, prints the front tables.
+/// Runs `pdm-ff tradeoff` (see the module docs): sweeps, writes the files, prints the front tables.
 pub fn run(args: &TradeoffArgs) -> Result<(), String> {
     let threads =
         if args.threads == 0 { std::thread::available_parallelism().map_or(1, usize::from) } else { args.threads };
@@ -245,7 +245,7 @@ fn run_in_pool(args: &TradeoffArgs) -> Result<(), String> {
     let mut front = String::new();
     let _ = writeln!(
         front,
-        "Pareto fronts of `pdm tradeoff` ({} rows; precisions: {}).\n",
+        "Pareto fronts of `pdm-ff tradeoff` ({} rows; precisions: {}).\n",
         rows.len(),
         distinct(rows.iter().map(|r| r.precision.as_str()))
     );

@@ -1,4 +1,4 @@
-//! `pdm validate`: the paper's section 4 test (a sphere in a cube) recomputed, with the paper's
+//! `pdm-ff validate`: the paper's section 4 test (a sphere in a cube) recomputed, with the paper's
 //! numbers, exact or independent reference values and relative errors beside ours.
 //!
 //! * sphere → face for each of the six faces (Table 1), eq. (25);

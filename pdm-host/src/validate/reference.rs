@@ -80,7 +80,7 @@ impl Reference {
 }
 
 /// `cube_face_factors(6, 1)` (adjacent, opposite, their error estimates), stored because it
-/// takes seconds (reproduce: `cargo run --release -p pdm-host --example cube_reference`); `pdm validate --recompute-reference` recomputes it, and the unit test
+/// takes seconds (reproduce: `cargo run --release -p pdm-host --example cube_reference`); `pdm-ff validate --recompute-reference` recomputes it, and the unit test
 /// `stored_reference_matches_cube_module` checks it.
 pub const STORED_R1: (f64, f64, f64, f64) =
     (0.19689310669952767, 0.15424993146874516, 6.071532165918825e-18, 2.8449465006019636e-16);

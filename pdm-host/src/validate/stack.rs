@@ -18,7 +18,7 @@ use pdm_kernel::{Real, MAX_ORDER};
 /// `tradeoff::engine`).
 pub const CAPACITIES: [usize; 6] = [25, 64, 144, 256, 576, MAX_ORDER * MAX_ORDER];
 
-/// `max_depth` of the tolerance mode in `pdm validate` and `pdm tradeoff`.
+/// `max_depth` of the tolerance mode in `pdm-ff validate` and `pdm-ff tradeoff`.
 pub const ADAPTIVE_MAX_DEPTH: u32 = 6;
 
 /// Kernel need, release: fixed part (bytes). Measured (VALIDATION.md): 148–160 KiB (f32) and
