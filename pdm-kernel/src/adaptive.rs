@@ -33,10 +33,12 @@
 //! 128 ε·|value| (2.8e-14 relative in f64, 1.5e-5 in f32); the total is the sum over the
 //! leaves. [`Estimate::converged`] is `true` if every leaf met the tolerance (estimate ≤
 //! tolerance·|value|, or value and estimate both zero) or the total estimate meets it against
-//! the total value; at the depth limit, or
-//! where the precision floor stops progress (a tolerance below 128 ε can never be met), the
-//! best value is returned with its estimate and `converged = false` — never silently above
-//! the tolerance. A caller who needs the tolerance checks the flag (or compares `error` with
+//! the total value; at the depth limit the best value is returned with its estimate and
+//! `converged = false` — never silently above the tolerance. A tolerance below 256 ε (5.7e-14
+//! in f64, 3.1e-5 in f32) is below what any estimate can show: the refinement works to 256 ε
+//! instead (it would otherwise split every pair to the depth limit, for minutes, without
+//! getting closer) and the result says `converged = false` unless its estimate meets the
+//! tolerance asked for. A caller who needs the tolerance checks the flag (or compares `error` with
 //! its own budget).
 //!
 //! * Smooth separate pairs and touching pairs (exponential convergence in the order): with
@@ -100,14 +102,19 @@ const SAFETY: f64 = 2.0;
 /// Rounding allowance on each leaf, in units of ε·|value|.
 const ROUNDING: f64 = 128.0;
 
+/// The smallest relative tolerance the refinement works to, in units of ε (twice the rounding
+/// allowance, so that a leaf can meet it): 5.7e-14 in f64, 3.1e-5 in f32.
+const PRECISION_FLOOR: f64 = 2.0 * ROUNDING;
+
 /// Settings of the tolerance-driven mode (validated by [`adaptive_exchange`]; see the module
 /// docs).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Adaptive<T> {
     /// Relative tolerance on each pair's exchange A_a·F_{a→b}: positive and finite. Below
-    /// 128 ε (2.8e-14 in f64, 1.5e-5 in f32) it cannot be met and the result has
-    /// `converged = false`.
+    /// 256 ε (5.7e-14 in f64, 3.1e-5 in f32) the refinement works to 256 ε instead (the
+    /// rounding allowance of every estimate, 128 ε, leaves nothing finer to reach), and the
+    /// result has `converged = false` unless its estimate happens to meet the tolerance.
     pub tolerance: T,
     /// Largest Gauss order before a pair is subdivided instead: 8..=`MAX_ORDER` (32). `CAP` must
     /// be ≥ `max_order`².
@@ -199,10 +206,16 @@ where
     if needed > CAP {
         return Err(PdmError::CapacityExceeded { needed, capacity: CAP });
     }
+    // Every leaf's estimate carries the rounding allowance ROUNDING·ε·|value|, so a leaf can
+    // meet only a tolerance above it: below, the refinement would split every pair down to
+    // `max_depth` without ever getting closer. It works to the precision floor instead, and
+    // the result then says whether the tolerance asked for was met (it cannot be).
+    let floor = T::from_f64(PRECISION_FLOOR) * T::EPSILON;
+    let work = Adaptive { tolerance: settings.tolerance.max(floor), ..settings };
     // Closed patches are cut at their seams first, as in `pair_exchange`.
     let mut e = Estimate::zero(0);
     crate::pair::for_each_piece_pair(a, b, |pa, pb| {
-        e.add(recurse::<T, SA, SB, O, CAP>(pa, pb, settings, occluders, 0)?);
+        e.add(recurse::<T, SA, SB, O, CAP>(pa, pb, work, occluders, 0)?);
         Ok(())
     })?;
     let (area_a, area_b) = (a.area(settings.max_order)?, b.area(settings.max_order)?);
@@ -212,7 +225,8 @@ where
     // The leaves judge their own estimates against their own values; a leaf of a tiny value
     // may miss that while the total meets the tolerance asked for (the pieces of a whole disk
     // far from the other's rim): the sum of the estimates bounds the total's error.
-    e.converged |= e.error <= settings.tolerance * e.value.abs();
+    e.converged |= e.error <= work.tolerance * e.value.abs();
+    e.converged &= work.tolerance == settings.tolerance || e.error <= settings.tolerance * e.value.abs();
     Ok(e)
 }
 

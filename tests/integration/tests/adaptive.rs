@@ -520,3 +520,46 @@ fn slow_sphere_to_coaxial_disk() {
         check("sphere -> coaxial disk", &total, reference, tol, PI, 1e-13);
     }
 }
+
+/// A tolerance below the precision floor (256 ε: every estimate carries a rounding allowance
+/// of 128 ε·|value|) cannot be shown to be met: the refinement stops at the floor instead of
+/// splitting every pair to the depth limit (f32 sphere → disk at 1e-6 once ran for minutes),
+/// so every tolerance below it does the same work, and the result says `converged = false`
+/// with an estimate that still bounds the error. Reference: sphere → coaxial disk,
+/// F = ½(1 − 1/√(1 + (a/h)²)) (sphere → polygon, REFERENCES.md), a = h = 1.
+#[test]
+fn tolerance_below_the_precision_floor_stops_there() {
+    let sphere = Sphere::outer(vec3(0.0f32, 0.0, 1.0), 0.5).unwrap();
+    let disk = Disk::new(vec3(0.0f32, 0.0, 0.0), vec3(0.0, 0.0, 1.0), 1.0).unwrap();
+    let (pa, pb) = (Patch::whole(&sphere).unwrap(), Patch::whole(&disk).unwrap());
+    let reference = 0.5 * (1.0 - 1.0 / 2.0_f64.sqrt()) * PI; // A_sphere·F = π·(…)
+    let floor_f32 = 256.0 * f32::EPSILON;
+    let at_floor = adaptive_exchange::<f32, _, _, _, 144>(&pa, &pb, Adaptive::new(floor_f32), &()).unwrap();
+    let mut work = vec![at_floor.evaluations];
+    for tol in [1e-6f32, 1e-12] {
+        let e = adaptive_exchange::<f32, _, _, _, 144>(&pa, &pb, Adaptive::new(tol), &()).unwrap();
+        let actual = (f64::from(e.value) - reference).abs();
+        println!(
+            "f32 sphere -> disk, tol {tol:.0e}: actual {:.2e}, estimate {:.2e}, {e:?}",
+            actual / reference,
+            f64::from(e.error) / reference
+        );
+        assert!(!e.converged, "f32 tol {tol:e}: {e:?}");
+        assert!(actual <= f64::from(e.error), "f32 tol {tol:e}: error {actual:e} above estimate {:e}", e.error);
+        work.push(e.evaluations);
+    }
+    assert!(work.iter().all(|&w| w == work[0]), "below the floor, the work at the floor: {work:?}");
+    let floor = square([0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]);
+    let ceiling = square([0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]);
+    let (pa, pb) = (Patch::whole(&floor).unwrap(), Patch::whole(&ceiling).unwrap());
+    let reference = exact::parallel_rectangles(1.0, 1.0, 1.0);
+    let mut work = vec![
+        adaptive_exchange::<f64, _, _, _, 144>(&pa, &pb, Adaptive::new(256.0 * f64::EPSILON), &()).unwrap().evaluations,
+    ];
+    for tol in [1e-15, 1e-30] {
+        let e = adaptive_exchange::<f64, _, _, _, 144>(&pa, &pb, Adaptive::new(tol), &()).unwrap();
+        assert!(!e.converged && (e.value - reference).abs() <= e.error, "f64 tol {tol:e}: {e:?}");
+        work.push(e.evaluations);
+    }
+    assert!(work.iter().all(|&w| w == work[0]), "f64: below the floor, the work at the floor: {work:?}");
+}
