@@ -189,6 +189,19 @@ impl<T: Real> Estimate<T> {
 /// the value is returned with `converged = false`). `CAP` ≥ `max_order`²; invalid settings are
 /// `Err(InvalidSetting)`, a smaller `CAP` `Err(CapacityExceeded)`, both before any work. The
 /// value is checked against 0 ≤ A_a·F_{a→b} ≤ min(A_a, A_b) (`Err(InvalidResult)` otherwise).
+///
+/// ```
+/// use pdm_kernel::{adaptive_exchange, vec3, Adaptive, Parallelogram, Patch};
+/// // Unit squares 1 apart (C-11: 0.1998248956983874) to a relative tolerance of 1e-8.
+/// let floor = Parallelogram::new(vec3(0.0, 0.0, 0.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0))?;
+/// let ceiling = Parallelogram::new(vec3(0.0, 0.0, 1.0), vec3(0.0, 1.0, 0.0), vec3(1.0, 0.0, 0.0))?;
+/// let (a, b) = (Patch::whole(&floor)?, Patch::whole(&ceiling)?);
+/// let e = adaptive_exchange::<f64, _, _, _, 144>(&a, &b, Adaptive::new(1e-8), &())?;
+/// assert!(e.converged, "check it: false means the tolerance was not met");
+/// assert!(e.error <= 1e-8 * e.value);
+/// assert!((e.value - 0.1998248956983874).abs() <= e.error); // A_a = 1
+/// # Ok::<(), pdm_kernel::PdmError>(())
+/// ```
 pub fn adaptive_exchange<T, SA, SB, O, const CAP: usize>(
     a: &Patch<'_, T, SA>,
     b: &Patch<'_, T, SB>,

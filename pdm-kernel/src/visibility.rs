@@ -36,6 +36,24 @@ pub fn mutually_facing<T: Real>(p_a: Vec3<T>, n_a: Vec3<T>, p_b: Vec3<T>, n_b: V
 }
 
 /// Something that may block the line of sight between two points.
+///
+/// Sphere, parallelogram, disk and cylinder are occluders; several combine as a tuple, an
+/// array, a slice or a `heapless::Vec` (of [`AnyOccluder`] to mix kinds), and `&()` means none.
+///
+/// ```
+/// use pdm_kernel::{pair_exchange, vec3, Disk, PairSettings, Parallelogram, Patch, Sphere};
+/// // Unit squares 1 apart (C-11: 0.1998248956983874). A sphere far to the side blocks
+/// // nothing; a large disk between them blocks everything.
+/// let floor = Parallelogram::new(vec3(0.0, 0.0, 0.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0))?;
+/// let ceiling = Parallelogram::new(vec3(0.0, 0.0, 1.0), vec3(0.0, 1.0, 0.0), vec3(1.0, 0.0, 0.0))?;
+/// let (a, b) = (Patch::whole(&floor)?, Patch::whole(&ceiling)?);
+/// let far = Sphere::outer(vec3(5.0, 5.0, 0.5), 1.0)?;
+/// let screen = Disk::new(vec3(0.5, 0.5, 0.5), vec3(0.0, 0.0, 1.0), 2.0)?;
+/// let seen = pair_exchange::<f64, _, _, _, 256>(&a, &b, PairSettings::ACCURATE, &far)?;
+/// let hidden = pair_exchange::<f64, _, _, _, 256>(&a, &b, PairSettings::ACCURATE, &(far, screen))?;
+/// assert!((seen - 0.1998248956983874).abs() < 1e-13 && hidden == 0.0);
+/// # Ok::<(), pdm_kernel::PdmError>(())
+/// ```
 pub trait Occluder<T: Real> {
     /// `true` if the open segment from `p` to `q` crosses the occluder (crossings within a
     /// relative distance `GEOMETRY_TOLERANCE` of an end point do not count).

@@ -9,6 +9,24 @@ use crate::vec3::{vec3, Vec3};
 /// The bicubic Bézier patch g(t, s) = Σᵢ Σⱼ Bᵢ(t) Bⱼ(s) P\[i\]\[j\], (t, s) ∈ [0, 1]², with the cubic
 /// Bernstein polynomials Bᵢ. Normal ∂g/∂t × ∂g/∂s from the Bernstein derivatives (closed form).
 /// Rows of `control` go along t, columns along s.
+///
+/// ```
+/// use pdm_kernel::{pair_exchange, vec3, BezierPatch, PairSettings, Parallelogram, Patch};
+/// // A flat Bézier patch whose control net is the uniform grid of the unit square, under a
+/// // parallel unit square 1 above it (catalogue C-11: 0.1998248956983874).
+/// let mut net = [[vec3(0.0, 0.0, 0.0); 4]; 4];
+/// for (i, row) in net.iter_mut().enumerate() {
+///     for (j, p) in row.iter_mut().enumerate() {
+///         *p = vec3(i as f64 / 3.0, j as f64 / 3.0, 0.0);
+///     }
+/// }
+/// let floor = BezierPatch::new(net)?;
+/// let ceiling = Parallelogram::new(vec3(0.0, 0.0, 1.0), vec3(0.0, 1.0, 0.0), vec3(1.0, 0.0, 0.0))?;
+/// let (a, b) = (Patch::whole(&floor)?, Patch::whole(&ceiling)?);
+/// let f = pair_exchange::<f64, _, _, _, 256>(&a, &b, PairSettings::ACCURATE, &())? / a.area(16)?;
+/// assert!((f - 0.1998248956983874).abs() < 1e-13);
+/// # Ok::<(), pdm_kernel::PdmError>(())
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct BezierPatch<T> {

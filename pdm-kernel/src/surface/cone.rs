@@ -11,6 +11,18 @@ use crate::vec3::Vec3;
 /// g(θ, z) = base + r(z)(cos θ · u + sin θ · w) + z · axis, r(z) = r₀ + (r₁ − r₀) z / h,
 /// θ ∈ [0, 2π] (t), z ∈ [0, h] (s). Normal ∂g/∂θ × ∂g/∂z = r(z)(cos θ · u + sin θ · w − k · axis)
 /// with k = (r₁ − r₀)/h: outward for [`Side::Outer`]; zero at an apex.
+///
+/// ```
+/// use pdm_kernel::{pair_exchange, vec3, Cone, Disk, PairSettings, Patch, Side};
+/// // The base disk of a cone (radius ½, height 1) sees only the cone's inside: F = 1
+/// // (enclosure sum rule; the flat base does not see itself).
+/// let base = Disk::new(vec3(0.0, 0.0, 0.0), vec3(0.0, 0.0, 1.0), 0.5)?;
+/// let cone = Cone::new(vec3(0.0, 0.0, 0.0), vec3(0.0, 0.0, 1.0), 0.5, 0.0, 1.0, Side::Inner)?;
+/// let (a, b) = (Patch::whole(&base)?, Patch::whole(&cone)?);
+/// let f = pair_exchange::<f64, _, _, _, 256>(&a, &b, PairSettings::ACCURATE, &())? / a.area(16)?;
+/// assert!((f - 1.0).abs() < 1e-11);
+/// # Ok::<(), pdm_kernel::PdmError>(())
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Cone<T> {

@@ -10,6 +10,19 @@ use crate::vec3::Vec3;
 /// g(θ, z) = base + R (cos θ · u + sin θ · w) + z · axis, θ ∈ [0, 2π] (t), z ∈ [0, h] (s).
 /// Normal ∂g/∂θ × ∂g/∂z = R (cos θ · u + sin θ · w): outward for [`Side::Outer`], negated for
 /// [`Side::Inner`] (the inside of a tube, which sees itself).
+///
+/// ```
+/// use pdm_kernel::{pair_exchange, vec3, Cylinder, Disk, PairSettings, Patch, Side};
+/// // A tube of radius 1 and height 1 closed by two disks: the base sees the top by C-41,
+/// // (3 − √5)/2, and the inside of the wall by the rest (enclosure sum rule). The base and the
+/// // wall share a curved edge (the rim).
+/// let base = Disk::new(vec3(0.0, 0.0, 0.0), vec3(0.0, 0.0, 1.0), 1.0)?;
+/// let wall = Cylinder::new(vec3(0.0, 0.0, 0.0), vec3(0.0, 0.0, 1.0), 1.0, 1.0, Side::Inner)?;
+/// let (a, b) = (Patch::whole(&base)?, Patch::whole(&wall)?);
+/// let f = pair_exchange::<f64, _, _, _, 256>(&a, &b, PairSettings::ACCURATE, &())? / a.area(16)?;
+/// assert!((f - (1.0 - (3.0 - 5.0_f64.sqrt()) / 2.0)).abs() < 1e-13);
+/// # Ok::<(), pdm_kernel::PdmError>(())
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Cylinder<T> {

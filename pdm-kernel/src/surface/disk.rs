@@ -10,6 +10,21 @@ use crate::vec3::Vec3;
 /// `frame.axis`: g(r, θ) = c + r (cos θ · u + sin θ · w), r ∈ [r_in, r_out] (t), θ ∈ [0, 2π] (s).
 /// Normal ∂g/∂r × ∂g/∂θ = r · axis (zero at the centre of a full disk), so the disk radiates
 /// towards `axis`; use [`Flipped`](super::Flipped) or a reversed axis for the other side.
+///
+/// ```
+/// use pdm_kernel::{pair_exchange, vec3, Disk, PairSettings, ParamRect, Patch};
+/// // Two coaxial unit disks 1 apart facing each other (catalogue C-41: (3 − √5)/2).
+/// let lower = Disk::new(vec3(0.0, 0.0, 0.0), vec3(0.0, 0.0, 1.0), 1.0)?;
+/// let upper = Disk::new(vec3(0.0, 0.0, 1.0), vec3(0.0, 0.0, -1.0), 1.0)?;
+/// let (a, b) = (Patch::whole(&lower)?, Patch::whole(&upper)?);
+/// let f = pair_exchange::<f64, _, _, _, 256>(&a, &b, PairSettings::ACCURATE, &())? / a.area(16)?;
+/// assert!((f - (3.0 - 5.0_f64.sqrt()) / 2.0).abs() < 1e-13);
+/// // Half of the lower disk (θ ∈ [0, π]) sees the upper one alike, by symmetry.
+/// let half = Patch::new(&lower, ParamRect::new(0.0, 1.0, 0.0, core::f64::consts::PI)?)?;
+/// let g = pair_exchange::<f64, _, _, _, 256>(&half, &b, PairSettings::ACCURATE, &())? / half.area(16)?;
+/// assert!((g - f).abs() < 1e-13);
+/// # Ok::<(), pdm_kernel::PdmError>(())
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Disk<T> {

@@ -8,6 +8,18 @@ use crate::vec3::{vec3, Vec3};
 
 /// The parallelogram g(t, s) = origin + t·edge_t + s·edge_s, (t, s) ∈ [0, 1]², with the constant
 /// normal n = edge_t × edge_s (its length is the area). Rectangles and squares are special cases.
+///
+/// ```
+/// use pdm_kernel::{form_factor_between, vec3, Parallelogram, Patch, Quadrature};
+/// // Unit squares 5 apart, facing each other (catalogue C-11: 1.240397731324e-2), by the paper's
+/// // plain sum; the normal edge_t × edge_s says which side radiates.
+/// let floor = Parallelogram::new(vec3(0.0, 0.0, 0.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0))?;
+/// let ceiling = Parallelogram::new(vec3(0.0, 0.0, 5.0), vec3(0.0, 1.0, 0.0), vec3(1.0, 0.0, 0.0))?;
+/// let f = form_factor_between::<f64, _, _, _, 64>(
+///     &Patch::whole(&floor)?, &Patch::whole(&ceiling)?, Quadrature::uniform(8), &())?;
+/// assert!((f - 1.240397731324e-2).abs() < 1e-12);
+/// # Ok::<(), pdm_kernel::PdmError>(())
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Parallelogram<T> {

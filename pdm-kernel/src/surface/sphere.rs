@@ -13,6 +13,20 @@ use crate::vec3::Vec3;
 /// axis. The closed-form normal is eq. (21), n = r² sin φ (sin φ cos θ, sin φ sin θ, cos φ),
 /// which points outward and vanishes at the poles (the area element is zero there; the kernel
 /// gives such points zero weight and never divides by |n|).
+///
+/// ```
+/// use pdm_kernel::{pair_exchange, vec3, Disk, PairSettings, Patch, Sphere};
+/// // A sphere of radius ½ whose centre is 1 above a coaxial disk of radius 1; the whole
+/// // sphere as one patch (its seam and poles are handled). Sphere → coaxial disk:
+/// // F = ½(1 − 1/√(1 + (a/h)²)) (sphere → polygon, Ω/4π), here ½(1 − 1/√2).
+/// let sphere = Sphere::outer(vec3(0.0, 0.0, 1.0), 0.5)?;
+/// let disk = Disk::new(vec3(0.0, 0.0, 0.0), vec3(0.0, 0.0, 1.0), 1.0)?;
+/// let (a, b) = (Patch::whole(&sphere)?, Patch::whole(&disk)?);
+/// let settings = PairSettings { order: 12, singular_order: 12, boundaries: true };
+/// let f = pair_exchange::<f64, _, _, _, 256>(&a, &b, settings, &())? / a.area(16)?;
+/// assert!((f - 0.5 * (1.0 - 1.0 / 2.0_f64.sqrt())).abs() < 1e-12);
+/// # Ok::<(), pdm_kernel::PdmError>(())
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Sphere<T> {
