@@ -33,8 +33,10 @@
 //! 128 ε·|value| (2.8e-14 relative in f64, 1.5e-5 in f32); the total is the sum over the
 //! leaves. [`Estimate::converged`] is `true` if every leaf met the tolerance (estimate ≤
 //! tolerance·|value|, or value and estimate both zero) or the total estimate meets it against
-//! the total value; at the depth limit the best value is returned with its estimate and
-//! `converged = false` — never silently above the tolerance. A tolerance below 256 ε (5.7e-14
+//! the total value; at the depth limit, or where a split would go below the resolution of the
+//! coordinates (f32 cells far from the origin), the best value is returned with its estimate
+//! and `converged = false` — never silently above the tolerance, and never an error after
+//! the work. A tolerance below 256 ε (5.7e-14
 //! in f64, 3.1e-5 in f32) is below what any estimate can show: the refinement works to 256 ε
 //! instead (it would otherwise split every pair to the depth limit, for minutes, without
 //! getting closer) and the result says `converged = false` unless its estimate meets the
@@ -565,10 +567,11 @@ where
             return Ok(Estimate { converged: accepted, ..leaf });
         }
         if next_p + 2 > last_order {
-            return match how {
+            let children = match how {
                 Split::Larger => split::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, evaluations),
                 Split::Both => split_both::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, evaluations),
             };
+            return or_parent(children, leaf);
         }
         previous_difference = Some(difference);
         prev = next;
@@ -642,7 +645,18 @@ where
     if leaf.converged || depth >= settings.max_depth {
         return Ok(leaf);
     }
-    split::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, leaf.evaluations)
+    or_parent(split::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, leaf.evaluations), leaf)
+}
+
+/// The children of a subdivision, or — where the working precision cannot carry it out (cells
+/// below the geometry's resolution: `Err(Degenerate)` or `Err(Unresolvable)` from a child) —
+/// the parent's value with its estimate, `converged = false`: that estimate was computed
+/// before the split and was above the tolerance, which is what the result then says.
+fn or_parent<T: Real>(children: Result<Estimate<T>, PdmError>, parent: Estimate<T>) -> Result<Estimate<T>, PdmError> {
+    match children {
+        Err(PdmError::Degenerate | PdmError::Unresolvable) => Ok(Estimate { converged: false, ..parent }),
+        other => other,
+    }
 }
 
 /// Splits both patches 2 × 2 at their parameter midpoints and recurses on the 16 sub-pairs;

@@ -563,3 +563,34 @@ fn tolerance_below_the_precision_floor_stops_there() {
     }
     assert!(work.iter().all(|&w| w == work[0]), "f64: below the floor, the work at the floor: {work:?}");
 }
+
+/// A subdivision the working precision cannot carry out (f32 cells of 1e-2 at 100 from the
+/// origin, halved towards the resolution of their coordinates) keeps the parent's value and
+/// estimate with `converged = false`, instead of failing with `Err(Degenerate)` after the work
+/// (as it once did, and still does for `max_depth` deep enough on any geometry). Unit squares
+/// 1 apart, scaled by 1e-2, with a tube of radius 0.25 between them; reference: the
+/// deterministic integration `squares_with_cylinder` (F is scale-invariant).
+#[test]
+fn subdivision_below_the_working_precision_keeps_the_parent() {
+    let (off, size) = (100.0f32, 0.01f32);
+    let o = vec3(off, off, off);
+    let floor = Parallelogram::new(o, vec3(size, 0.0, 0.0), vec3(0.0, size, 0.0)).unwrap();
+    let ceiling = Parallelogram::new(o + vec3(0.0, 0.0, size), vec3(0.0, size, 0.0), vec3(size, 0.0, 0.0)).unwrap();
+    let axis_start = o + vec3(0.5 * size, -size, 0.5 * size);
+    let tube = Cylinder::new(axis_start, vec3(0.0, 1.0, 0.0), 0.25 * size, 3.0 * size, Side::Outer).unwrap();
+    let (pa, pb) = (Patch::whole(&floor).unwrap(), Patch::whole(&ceiling).unwrap());
+    let reference = squares_with_cylinder(0.5, 0.5, 0.25);
+    let settings = Adaptive { tolerance: 1e-4, max_order: 12, max_depth: 16 };
+    let e = adaptive_exchange::<f32, _, _, _, 144>(&pa, &pb, settings, &tube).unwrap();
+    let area = f64::from(size) * f64::from(size);
+    let (value, error) = (f64::from(e.value) / area, f64::from(e.error) / area);
+    println!(
+        "f32 squares 1e-2 at 100 with a tube: F {value:.7e} (reference {reference:.7e}), estimate {error:.2e}, {e:?}"
+    );
+    assert!(!e.converged, "{e:?}");
+    assert!(
+        (value - reference).abs() <= error,
+        "error {:.2e} above the estimate {error:.2e}",
+        (value - reference).abs()
+    );
+}
