@@ -50,7 +50,8 @@
 //! or 2·order + 3 probes + ≈ 60 bisection probes per boundary, + order evaluations per visible
 //! piece), plus the s-level search (3 polynomial evaluations, ≤ 2 structure tests per
 //! candidate). No allocation: breakpoints live in fixed-size arrays (at most [`MAX_BREAKS`]
-//! per line; more is `Err(CapacityExceeded)`).
+//! per line; a part with more is halved, and after [`MAX_SPLITS`] halvings integrated by the plain
+//! rule with the visibility tested per node).
 //!
 //! Limitation: without closed form, a visibility change narrower than the bracketing grid
 //! spacing (a shadow sliver between two probes) is not seen; its contribution is then sampled
@@ -66,7 +67,8 @@ use crate::vec3::{vec3, Vec3};
 use crate::visibility::Occluder;
 
 /// Largest number of visibility changes located on one inner line or in s at once; a part of
-/// the inner patch with more is halved (see [`MAX_SPLITS`]).
+/// the inner patch with more is halved (see [`MAX_SPLITS`]), and one that still has more is
+/// integrated by the plain rule with visibility tested per node.
 pub const MAX_BREAKS: usize = 16;
 
 /// Most successive 2 × 2 refinements of the inner patch towards an outer point closer than its
@@ -74,8 +76,12 @@ pub const MAX_BREAKS: usize = 16;
 pub const MAX_NEAR_DEPTH: u32 = 30;
 
 /// Most successive halvings of the inner patch when its visibility changes overflow
-/// [`MAX_BREAKS`] (≤ 2^MAX_SPLITS parts per outer point).
-pub const MAX_SPLITS: u32 = 10;
+/// [`MAX_BREAKS`] (≤ 2^MAX_SPLITS parts per outer point, 8 per direction: room for about
+/// 8 · [`MAX_BREAKS`] changes along one line, 60 shadows); past them the part takes the plain
+/// rule with visibility tested per node. Changes that halving does not separate — rounding
+/// noise where a boundary grazes b along a line, or a pattern finer than any part — would
+/// otherwise cost 2^(depth + 1) attempts per outer point.
+pub const MAX_SPLITS: u32 = 6;
 
 /// A_a·F_{a→b} with visibility boundaries placed into the inner rule (see the module docs);
 /// `order` points per axis on a and per line and per visible piece on b.
@@ -589,8 +595,28 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
                 };
                 Ok(self.integral_split(p, np, lo, depth + 1)? + self.integral_split(p, np, hi, depth + 1)?)
             }
+            Err(PdmError::CapacityExceeded { .. }) => Ok(self.integral_sampled(p, np, r)),
             other => other,
         }
+    }
+
+    /// J(p) over a part r of b that still holds more visibility changes than the buffers after
+    /// [`MAX_SPLITS`] halvings (at most a ⅛ × ⅛ part of b: changes that halving does not
+    /// separate, such as rounding noise where a boundary grazes b along a line): the tensor Gauss rule with the visibility tested at
+    /// each node, as the plain sum does. Its error stays within that part.
+    fn integral_sampled(&self, p: Vec3<T>, np: Vec3<T>, r: ParamRect<T>) -> T {
+        let (ht, hs) = ((r.t1 - r.t0) * T::HALF, (r.s1 - r.s0) * T::HALF);
+        let mut sum = T::ZERO;
+        for (xs, ws) in self.rule.points() {
+            let s = r.s0 + hs * (xs + T::ONE);
+            for (xt, wt) in self.rule.points() {
+                let (q, nq) = self.surface.point_and_normal(r.t0 + ht * (xt + T::ONE), s);
+                if self.visible(p, np, q, nq) {
+                    sum += ws * wt * kernel_unoccluded(p, np, q, nq);
+                }
+            }
+        }
+        sum * ht * hs
     }
 
     /// J(p) over the part r of b (r's t- and s-ranges inside b's).
