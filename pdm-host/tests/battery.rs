@@ -51,8 +51,9 @@ use pdm_kernel::{
     AutoNormal, BezierPatch, Cone, Cylinder, Disk, Frame, PairSettings, Parallelogram, ParamRect, ParametricMap, Patch,
     PatchGrid, PdmError, Quadrature, Real, Scalar, Side, Sphere, Surface, Vec3,
 };
+use std::collections::HashMap;
 use std::f64::consts::PI;
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Instant;
 
 const CAP: usize = 324; // ≥ (16 + 1)² (self pairs at order 16) and ≥ (12 + 2)² (adaptive)
@@ -356,6 +357,21 @@ fn rect_of(s: &Surf) -> [f64; 4] {
     s.rect.unwrap_or_else(|| s.kind.domain())
 }
 
+/// The case's reference, computed once per test binary run: the class tests and
+/// `slow_plain_rule_right_on_every_case` share it (a Monte Carlo or direct reference is most of
+/// a case's time). The Monte Carlo seed is a hash of the case's name (FNV-1a), so a case gets the
+/// same rays whichever test computes it first.
+fn cached_reference(c: &Case) -> Ref {
+    type Cache = Mutex<HashMap<String, Arc<OnceLock<Ref>>>>;
+    static CACHE: OnceLock<Cache> = OnceLock::new();
+    let slot = match CACHE.get_or_init(Default::default).lock() {
+        Ok(mut m) => m.entry(c.name.clone()).or_default().clone(),
+        Err(_) => Arc::default(),
+    };
+    let seed = c.name.bytes().fold(0xcbf2_9ce4_8422_2325_u64, |h, b| (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3));
+    *slot.get_or_init(|| reference(c, seed))
+}
+
 fn reference(c: &Case, seed: u64) -> Ref {
     let (ra, rb) = (rect_of(&c.a), rect_of(&c.b));
     let area = |s: &Surf, r: [f64; 4]| match s.kind.rt(r) {
@@ -640,8 +656,8 @@ fn run_precision<T: Real>(c: &Case, r: &Ref, out: &mut Outcome, label: &str) {
     ));
 }
 
-fn run_case(c: &Case, seed: u64) -> Outcome {
-    let r = reference(c, seed);
+fn run_case(c: &Case) -> Outcome {
+    let r = cached_reference(c);
     let mut out = Outcome { est_ratio: f64::INFINITY, ..Outcome::default() };
     if !(r.f.is_finite() && r.area_a > 0.0 && r.area_b > 0.0) {
         out.failures.push(format!("{}: bad reference {r:?}", c.name));
@@ -668,7 +684,7 @@ fn run(cases: Vec<Case>) {
         };
         let Some(c) = cases.get(i) else { return };
         let t = Instant::now();
-        let mut o = run_case(c, 1000 + i as u64);
+        let mut o = run_case(c);
         o.lines.push(format!("  ({:.2} s)", t.elapsed().as_secs_f64()));
         if trace() {
             eprintln!("{}\n{}", o.lines.join("\n"), o.failures.join("\n"));
@@ -1396,8 +1412,8 @@ single_case! {
 fn slow_plain_rule_right_on_every_case() {
     let cases: Vec<Case> = all_cases().into_iter().filter(|c| !c.slow).collect();
     let mut failures = Vec::new();
-    for (i, c) in cases.iter().enumerate() {
-        let r = reference(c, 1000 + i as u64);
+    for c in &cases {
+        let r = cached_reference(c);
         let built = kernel_surface::<f64>(&c.a.kind).and_then(|a| Ok((a, kernel_surface::<f64>(&c.b.kind)?)));
         let occ: Result<Vec<AnyOccluder<f64>>, _> = c.occ.iter().map(Occ::kernel).collect();
         let (Ok((sa, sb)), Ok(occ)) = (built, occ) else { panic!("{}: geometry", c.name) };
