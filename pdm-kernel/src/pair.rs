@@ -93,9 +93,15 @@ impl PairSettings {
 ///   outer integrand jump along the cut, and the outer rule converges only like 1/order (a
 ///   partition plate through two parallel rectangles, dividing both: 7.8e-4 at order 12,
 ///   5.1e-4 at 16; split the patches along the cut, or use the tolerance mode);
-/// - curved (not flat) patches closer than their size to another patch's edge (a sphere cell
-///   0.01 above a plate's edge region: 1e-4 to 1e-5 at orders 12 to 16; two flat patches take
-///   the contour form instead, exact at any gap);
+/// - a curved (not flat) patch much closer to another patch than its size: the outer integrand
+///   has a layer on the scale of the gap (a peak under the closest point, a step where one
+///   patch passes over the other's edge), which one outer rule over the whole patch does not
+///   resolve, so the error does not fall with the order (a sphere cell 0.01 above a plate's
+///   edge region: 1e-4 to 1e-5 at orders 12 to 16; a sphere cell of radius 0.3 whose lowest
+///   point is 1e-3 above a plate cell near its corner: 3 % to 5 % at orders 8 to 14, up to
+///   53 % at orders 16 to 20, where the choice of the outer patch flips). Subdivide such pairs
+///   towards the contact, or use the tolerance mode, which is right there. Two flat patches
+///   take the contour form instead, exact at any gap;
 /// - self and edge pairs reaching a side that collapses to a point on a concave surface (the
 ///   pieces of a cone's inside at its apex: the whole wall against itself 2.0e-5 off at
 ///   singular order 12, 6.6e-6 at 16; a frustum, without the apex, 8e-11);
