@@ -7,7 +7,7 @@
 //! every user of the kernel in that build.
 //!
 //! Accuracy cost of `micromath` (measured by `tests/integration/tests/precision_backends.rs`,
-//! see README "Precision backends"): micromath's `sin`/`cos`/`atan` are accurate to about 1e-3;
+//! see RESULTS.md "Precision backends"): micromath's `sin`/`cos`/`atan` are accurate to about 1e-3;
 //! its `sqrt` (a bit-trick estimate, ≈ 5 % off) is refined here by two Newton steps to ≈ 1e-7.
 //! On form factors in f32: C-11 squares 1.1e-6 (as libm: only `sqrt` is involved), C-41 disks
 //! 3.7e-4, sphere → cube face 7.0e-4, against 6e-7…1e-6 with libm. Points placed by sin/cos lie
