@@ -368,8 +368,11 @@ fn cached_reference(c: &Case) -> Ref {
         Ok(mut m) => m.entry(c.name.clone()).or_default().clone(),
         Err(_) => Arc::default(),
     };
-    let seed = c.name.bytes().fold(0xcbf2_9ce4_8422_2325_u64, |h, b| (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3));
-    *slot.get_or_init(|| reference(c, seed))
+    *slot.get_or_init(|| {
+        let seed =
+            c.name.bytes().fold(0xcbf2_9ce4_8422_2325_u64, |h, b| (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3));
+        reference(c, seed)
+    })
 }
 
 fn reference(c: &Case, seed: u64) -> Ref {

@@ -602,8 +602,9 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
 
     /// J(p) over a part r of b that still holds more visibility changes than the buffers after
     /// [`MAX_SPLITS`] halvings (at most a ⅛ × ⅛ part of b: changes that halving does not
-    /// separate, such as rounding noise where a boundary grazes b along a line): the tensor Gauss rule with the visibility tested at
-    /// each node, as the plain sum does. Its error stays within that part.
+    /// separate, such as rounding noise where a boundary grazes b along a line): the tensor
+    /// Gauss rule with the visibility tested at each node, as the plain sum does. Its error
+    /// stays within that part.
     fn integral_sampled(&self, p: Vec3<T>, np: Vec3<T>, r: ParamRect<T>) -> T {
         let (ht, hs) = ((r.t1 - r.t0) * T::HALF, (r.s1 - r.s0) * T::HALF);
         let mut sum = T::ZERO;
