@@ -133,7 +133,8 @@ where
     O: Occluder<T> + ?Sized,
 {
     let count = core::cell::Cell::new(0u64);
-    let outer = PatchSamples::<T, CAP>::new(a, order)?;
+    let mut outer = PatchSamples::<T, CAP>::new(a, order)?;
+    let area_a = outer.area();
     let inner_samples = PatchSamples::<T, CAP>::new(b, order)?; // validates b (area, finiteness)
     let r = b.rect();
     let surface = b.surface();
@@ -167,6 +168,110 @@ where
         scratch: core::cell::RefCell::new(LineScratch::new()),
         signature_line: core::cell::RefCell::new(Line::new()),
     };
+    // The outer integrand J(p) varies on the scale of p's distance to b: where the pair is very
+    // near (`very_near`; a sphere 1e-3 above a plate: J peaks under the closest point, and steps
+    // where a passes over b's edges, both on the gap's scale), the outer rule over the whole of
+    // a samples a layer it cannot resolve and its error does not fall with the order. a is then
+    // cut into cells, each no closer to b than its own radius (`outer_cells`).
+    let (cells, n_cells) = outer_cells(a, b, &inner)?;
+    let mut total = T::ZERO;
+    if n_cells > 1 {
+        for cell in cells.iter().take(n_cells) {
+            outer.fill(&Patch::new(a.surface(), *cell)?, order, order)?;
+            total += outer_sum(&outer, &inner, &inner_samples, &inner_bounds)?;
+        }
+    } else {
+        total = outer_sum(&outer, &inner, &inner_samples, &inner_bounds)?;
+    }
+    let value = crate::bounds::finite(total * T::FRAC_1_PI)?;
+    Ok((value, count.get(), area_a, inner_samples.area()))
+}
+
+/// Most cells into which [`outer_cells`] cuts the outer patch (each costs one outer rule).
+pub(crate) const MAX_OUTER_CELLS: usize = 8;
+
+/// The outer patch a cut, by halving across its physically longer direction, until no cell is
+/// closer to b than its own radius, at most [`MAX_OUTER_CELLS`] cells; the cell closest to b
+/// relative to its radius is halved first, so that the cells grade towards where a comes
+/// closest to b. One cell (a itself) for a pair farther apart than a's size.
+fn outer_cells<T, SA, SB, O>(
+    a: &Patch<'_, T, SA>,
+    inner_patch: &Patch<'_, T, SB>,
+    inner: &Inner<'_, T, SB, O>,
+) -> Result<([ParamRect<T>; MAX_OUTER_CELLS], usize), PdmError>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
+    let g = a.surface();
+    // A cell's distance to b in its own radii (below 1: to be halved).
+    let ratio = |r: ParamRect<T>| -> Result<T, PdmError> {
+        let ball = Patch::new(g, r)?.enclosing_ball();
+        if !(ball.radius > T::ZERO) {
+            return Ok(T::MAX);
+        }
+        Ok(inner.distance_from(&ball, inner.r)? / ball.radius)
+    };
+    let mut cells = [a.rect(); MAX_OUTER_CELLS];
+    let mut ratios = [T::MAX; MAX_OUTER_CELLS];
+    // A pair that is not very near keeps one cell: its layer is resolved by the rule over a.
+    if !very_near(a, inner_patch)? {
+        return Ok((cells, 1));
+    }
+    let whole = ratio(a.rect())?;
+    if let Some(q) = ratios.get_mut(0) {
+        *q = whole;
+    }
+    let mut n = 1usize;
+    while n < MAX_OUTER_CELLS {
+        let mut pick = None;
+        let mut least = T::ONE;
+        for (k, &q) in ratios.iter().enumerate().take(n) {
+            if q < least {
+                least = q;
+                pick = Some(k);
+            }
+        }
+        let Some(k) = pick else { break };
+        let Some(&r) = cells.get(k) else { break };
+        let (tm, sm) = ((r.t0 + r.t1) * T::HALF, (r.s0 + r.s1) * T::HALF);
+        let along_t = (g.point(r.t1, sm) - g.point(r.t0, sm)).norm();
+        let along_s = (g.point(tm, r.s1) - g.point(tm, r.s0)).norm();
+        let (lo, hi) = if along_t >= along_s {
+            (ParamRect { t1: tm, ..r }, ParamRect { t0: tm, ..r })
+        } else {
+            (ParamRect { s1: sm, ..r }, ParamRect { s0: sm, ..r })
+        };
+        let (q_lo, q_hi) = (ratio(lo)?, ratio(hi)?);
+        if let (Some(c), Some(q)) = (cells.get_mut(k), ratios.get_mut(k)) {
+            *c = lo;
+            *q = q_lo;
+        }
+        if let (Some(c), Some(q)) = (cells.get_mut(n), ratios.get_mut(n)) {
+            *c = hi;
+            *q = q_hi;
+        }
+        n += 1;
+    }
+    Ok((cells, n))
+}
+
+/// The outer sum Σ w_p J(p) over one set of outer samples (see [`boundary_unchecked`]).
+fn outer_sum<T, SB, O, const CAP: usize>(
+    outer: &PatchSamples<T, CAP>,
+    inner: &Inner<'_, T, SB, O>,
+    inner_samples: &PatchSamples<T, CAP>,
+    inner_bounds: &Ball<T>,
+) -> Result<T, PdmError>
+where
+    T: Real,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
+    let (use_occluders, occluders, count, r) = (inner.use_occluders, inner.occluders, inner.count, inner.r);
+    let inner_bounds = *inner_bounds;
     let mut total = T::ZERO;
     for sample in outer.iter() {
         if sample.weight == T::ZERO {
@@ -203,9 +308,99 @@ where
         };
         total += sample.weight * j;
     }
-    let value = crate::bounds::finite(total * T::FRAC_1_PI)?;
-    Ok((value, count.get(), outer.area(), inner_samples.area()))
+    Ok(total)
 }
+
+/// The distance from `ball` to the part r of a surface, to within the ball's radius (parts
+/// refined 2 × 2 down to a quarter of it, at most [`MAX_NEAR_DEPTH`] times; parts no closer
+/// than `best` pruned). A lower bound: 0 where the ball reaches the surface.
+fn distance_to_part<T: Real, S: Surface<T> + ?Sized>(
+    surface: &S,
+    affine: Option<(Vec3<T>, Vec3<T>, Vec3<T>)>,
+    ball: &Ball<T>,
+    r: ParamRect<T>,
+    best: T,
+    depth: u32,
+) -> Result<T, PdmError> {
+    let part = part_ball(surface, affine, r)?;
+    let centres = (part.center - ball.center).norm();
+    let gap = (centres - part.radius - ball.radius).max(T::ZERO);
+    if !(gap < best) {
+        return Ok(best);
+    }
+    if part.radius * T::from_f64(4.0) <= ball.radius || depth >= MAX_NEAR_DEPTH {
+        return Ok(gap.min(best));
+    }
+    let mut best = best;
+    for k in 0..4 {
+        best = distance_to_part(surface, affine, ball, r.cell(k / 2, k % 2, 2, 2), best, depth + 1)?;
+    }
+    Ok(best)
+}
+
+/// Whether the gap between the patches is below [`VERY_NEAR`] of the smaller one's radius
+/// (enclosing balls). Pairs of parts of the two are refined, the larger part 2 × 2 first: a
+/// pair whose balls are farther apart than that gap is not very near; one whose centre points
+/// (the surfaces at the parts' parameter centres) are closer is. Past [`MAX_NEAR_DEPTH`]
+/// halvings of both, the centre points decide.
+pub(crate) fn very_near<T, SA, SB>(a: &Patch<'_, T, SA>, b: &Patch<'_, T, SB>) -> Result<bool, PdmError>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+{
+    let (ball_a, ball_b) = (a.enclosing_ball(), b.enclosing_ball());
+    let limit = T::from_f64(VERY_NEAR) * ball_a.radius.min(ball_b.radius);
+    if !(limit > T::ZERO) {
+        return Ok(false);
+    }
+    parts_near(a, ball_a, b, ball_b, limit, 0)
+}
+
+/// [`very_near`] on the parts a and b (patches of the original two) with balls `ba`, `bb`.
+fn parts_near<T, SA, SB>(
+    a: &Patch<'_, T, SA>,
+    ba: Ball<T>,
+    b: &Patch<'_, T, SB>,
+    bb: Ball<T>,
+    limit: T,
+    depth: u32,
+) -> Result<bool, PdmError>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+{
+    if !((ba.center - bb.center).norm() - ba.radius - bb.radius < limit) {
+        return Ok(false);
+    }
+    let centre = |p: &Patch<'_, T, SA>| {
+        let r = p.rect();
+        p.surface().point((r.t0 + r.t1) * T::HALF, (r.s0 + r.s1) * T::HALF)
+    };
+    let r = b.rect();
+    let centre_b = b.surface().point((r.t0 + r.t1) * T::HALF, (r.s0 + r.s1) * T::HALF);
+    if (centre(a) - centre_b).norm() < limit || depth >= 2 * MAX_NEAR_DEPTH {
+        return Ok((centre(a) - centre_b).norm() < limit);
+    }
+    for k in 0..4 {
+        let found = if ba.radius >= bb.radius {
+            let part = Patch::new(a.surface(), a.rect().cell(k / 2, k % 2, 2, 2))?;
+            parts_near(&part, part.enclosing_ball(), b, bb, limit, depth + 1)?
+        } else {
+            let part = Patch::new(b.surface(), b.rect().cell(k / 2, k % 2, 2, 2))?;
+            parts_near(a, ba, &part, part.enclosing_ball(), limit, depth + 1)?
+        };
+        if found {
+            return Ok(true);
+        }
+    }
+    Ok(false)
+}
+
+/// The gap, in the smaller patch's radius, below which a pair counts as very near
+/// ([`very_near`]): its outer integrand has a layer on the gap's scale.
+pub(crate) const VERY_NEAR: f64 = 0.75;
 
 /// The smallest ball known to contain the part r of a surface: from its corners when the
 /// surface is flat (`affine`, its affine map), else [`Patch::enclosing_ball`].
@@ -558,6 +753,11 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
     /// converges slowly (the kernel's nearest singularity, at p, is within the patch's size).
     fn near(&self, p: Vec3<T>, ball: &Ball<T>) -> bool {
         (ball.center - p).norm() - ball.radius < ball.radius
+    }
+
+    /// The distance from `ball` to the part r of b ([`distance_to_part`]).
+    fn distance_from(&self, ball: &Ball<T>, r: ParamRect<T>) -> Result<T, PdmError> {
+        distance_to_part(self.surface, self.affine, ball, r, T::MAX, 0)
     }
 
     /// The smallest ball known to contain the part r of b (exact corners when flat).

@@ -26,9 +26,9 @@
 //!   their size gets the visibility boundaries placed into the inner rule and the inner patch
 //!   refined towards each outer point ([`crate::boundary`]; the outer patch is also split
 //!   [`OCCLUDED_OUTER_SPLIT`]² when an occluder may cut); smooth, distant, unoccludable pairs
-//!   keep the plain sum. Without occluders the outer patch is the one with fewer points that
-//!   see none of the other, then the one whose points stay farther from the other's edges
-//!   (`outer_is_b`).
+//!   keep the plain sum. Without occluders the outer patch is, for a very near pair with one
+//!   flat patch, the curved one; otherwise the one with fewer points that see none of the
+//!   other, then the one whose points stay farther from the other's edges (`outer_is_b`).
 //!
 //! Every value is checked against the physical bounds 0 ≤ A_a·F_{a→b} ≤ min(A_a, A_b) before
 //! it is returned.
@@ -93,15 +93,15 @@ impl PairSettings {
 ///   outer integrand jump along the cut, and the outer rule converges only like 1/order (a
 ///   partition plate through two parallel rectangles, dividing both: 7.8e-4 at order 12,
 ///   5.1e-4 at 16; split the patches along the cut, or use the tolerance mode);
-/// - a curved (not flat) patch much closer to another patch than its size: the outer integrand
-///   has a layer on the scale of the gap (a peak under the closest point, a step where one
-///   patch passes over the other's edge), which one outer rule over the whole patch does not
-///   resolve, so the error does not fall with the order (a sphere cell 0.01 above a plate's
-///   edge region: 1e-4 to 1e-5 at orders 12 to 16; a sphere cell of radius 0.3 whose lowest
-///   point is 1e-3 above a plate cell near its corner: 3 % to 5 % at orders 8 to 14, up to
-///   53 % at orders 16 to 20, where the choice of the outer patch flips). Subdivide such pairs
-///   towards the contact, or use the tolerance mode, which is right there. Two flat patches
-///   take the contour form instead, exact at any gap;
+/// - a curved (not flat) patch closer to another patch than the smaller one's size: the outer
+///   integrand has a layer on the scale of the gap (a peak under the closest point, a step
+///   where one patch passes over the other's edge). The boundary path cuts the outer patch
+///   into up to 8 cells graded towards the inner one and puts a flat patch inside
+///   ([`crate::boundary`]); a sphere cell of radius 0.3 whose lowest point is 1e-1, 3e-2 or
+///   1e-3 above a plate cell near its corner: 6.0e-9 / 5.1e-7 / 1.1e-6 at order 12, 8.3e-10 /
+///   1.2e-7 / 1.0e-7 at 16 (test `trust::sphere_cell_close_above_a_plate_cell`). Closer still,
+///   the 8 cells stop resolving the layer: subdivide such pairs towards the contact, or use the
+///   tolerance mode. Two flat patches take the contour form instead, exact at any gap;
 /// - self and edge pairs reaching a side that collapses to a point on a concave surface (the
 ///   pieces of a cone's inside at its apex: the whole wall against itself 2.0e-5 off at
 ///   singular order 12, 6.6e-6 at 16; a frustum, without the apex, 8e-11);
@@ -427,6 +427,15 @@ where
     SA: Surface<T> + ?Sized,
     SB: Surface<T> + ?Sized,
 {
+    // Very near (`boundary::very_near`) with exactly one patch flat: the flat one goes inside. A point of
+    // the curved patch sees the flat one cut by one plane (its tangent plane), which the inner
+    // rule places in closed form or brackets as a line; a point of the flat patch may see only
+    // a small cap of the curved one (a sphere cell 1e-3 above a plate: a cap of radius
+    // √(2·R·gap)), which a probe grid misses. The blind-point count below is a sample count
+    // that changes with the order on such a pair.
+    if is_flat(a) != is_flat(b) && crate::boundary::very_near(a, b).unwrap_or(false) {
+        return is_flat(a);
+    }
     let (blind_a, blind_b) = (blind_points(sa, sb), blind_points(sb, sa));
     if blind_a != blind_b {
         return blind_b < blind_a;
