@@ -333,7 +333,11 @@ fn distance_to_part<T: Real, S: Surface<T> + ?Sized>(
     }
     let mut best = best;
     for k in 0..4 {
-        best = distance_to_part(surface, affine, ball, r.cell(k / 2, k % 2, 2, 2), best, depth + 1)?;
+        // A part below the coordinates' resolution (f32) ends the refinement at its parent.
+        match distance_to_part(surface, affine, ball, r.cell(k / 2, k % 2, 2, 2), best, depth + 1) {
+            Ok(d) => best = d,
+            Err(_) => return Ok(gap.min(best)),
+        }
     }
     Ok(best)
 }
@@ -342,7 +346,8 @@ fn distance_to_part<T: Real, S: Surface<T> + ?Sized>(
 /// (enclosing balls). Pairs of parts of the two are refined, the larger part 2 × 2 first: a
 /// pair whose balls are farther apart than that gap is not very near; one whose centre points
 /// (the surfaces at the parts' parameter centres) are closer is. Past [`MAX_NEAR_DEPTH`]
-/// halvings of both, the centre points decide.
+/// halvings of both, or where a part falls below the coordinates' resolution, the centre points
+/// decide.
 pub(crate) fn very_near<T, SA, SB>(a: &Patch<'_, T, SA>, b: &Patch<'_, T, SB>) -> Result<bool, PdmError>
 where
     T: Real,
@@ -380,15 +385,17 @@ where
     };
     let r = b.rect();
     let centre_b = b.surface().point((r.t0 + r.t1) * T::HALF, (r.s0 + r.s1) * T::HALF);
-    if (centre(a) - centre_b).norm() < limit || depth >= 2 * MAX_NEAR_DEPTH {
-        return Ok((centre(a) - centre_b).norm() < limit);
+    let decided = (centre(a) - centre_b).norm() < limit;
+    if decided || depth >= 2 * MAX_NEAR_DEPTH {
+        return Ok(decided);
     }
     for k in 0..4 {
+        // A part below the coordinates' resolution (f32): the centre points decide.
         let found = if ba.radius >= bb.radius {
-            let part = Patch::new(a.surface(), a.rect().cell(k / 2, k % 2, 2, 2))?;
+            let Ok(part) = Patch::new(a.surface(), a.rect().cell(k / 2, k % 2, 2, 2)) else { return Ok(decided) };
             parts_near(&part, part.enclosing_ball(), b, bb, limit, depth + 1)?
         } else {
-            let part = Patch::new(b.surface(), b.rect().cell(k / 2, k % 2, 2, 2))?;
+            let Ok(part) = Patch::new(b.surface(), b.rect().cell(k / 2, k % 2, 2, 2)) else { return Ok(decided) };
             parts_near(a, ba, &part, part.enclosing_ball(), limit, depth + 1)?
         };
         if found {
