@@ -726,7 +726,7 @@ const SIDE_SEGMENTS: usize = 12;
 /// Arc lengths of a patch's image along t and along s: the longest of the polylines (12
 /// segments) along the two edges and the mid-line in each direction. A chord would be zero on a
 /// side that closes on itself (the θ side of a whole disk, cylinder or sphere band).
-fn side_lengths<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>) -> (T, T) {
+pub(crate) fn side_lengths<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>) -> (T, T) {
     let r = p.rect();
     let g = p.surface();
     let n = T::from_usize(SIDE_SEGMENTS);
@@ -752,7 +752,7 @@ fn side_lengths<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>) -> (T, T) 
 
 /// Half `k` (0 or 1) of a patch with side lengths `(along_t, along_s)`, split across the
 /// longer one.
-fn half_patch<'s, T: Real, S: Surface<T> + ?Sized>(
+pub(crate) fn half_patch<'s, T: Real, S: Surface<T> + ?Sized>(
     p: &Patch<'s, T, S>,
     (along_t, along_s): (T, T),
     k: usize,

@@ -190,10 +190,10 @@ where
 /// Most cells into which [`outer_cells`] cuts the outer patch (each costs one outer rule).
 pub(crate) const MAX_OUTER_CELLS: usize = 8;
 
-/// The outer patch a cut, by halving across its physically longer direction, until no cell is
+/// The outer patch a cut, by halving across its longer side (arc length), until no cell is
 /// closer to b than its own radius, at most [`MAX_OUTER_CELLS`] cells; the cell closest to b
 /// relative to its radius is halved first, so that the cells grade towards where a comes
-/// closest to b. One cell (a itself) for a pair farther apart than a's size.
+/// closest to b. One cell (a itself) for a pair that is not [`very_near`].
 fn outer_cells<T, SA, SB, O>(
     a: &Patch<'_, T, SA>,
     inner_patch: &Patch<'_, T, SB>,
@@ -214,16 +214,12 @@ where
         }
         Ok(inner.distance_from(&ball, inner.r)? / ball.radius)
     };
-    let mut cells = [a.rect(); MAX_OUTER_CELLS];
-    let mut ratios = [T::MAX; MAX_OUTER_CELLS];
     // A pair that is not very near keeps one cell: its layer is resolved by the rule over a.
+    let mut cells = [a.rect(); MAX_OUTER_CELLS];
     if !very_near(a, inner_patch)? {
         return Ok((cells, 1));
     }
-    let whole = ratio(a.rect())?;
-    if let Some(q) = ratios.get_mut(0) {
-        *q = whole;
-    }
+    let mut ratios = [ratio(a.rect())?; MAX_OUTER_CELLS];
     let mut n = 1usize;
     while n < MAX_OUTER_CELLS {
         let mut pick = None;
@@ -236,14 +232,16 @@ where
         }
         let Some(k) = pick else { break };
         let Some(&r) = cells.get(k) else { break };
-        let (tm, sm) = ((r.t0 + r.t1) * T::HALF, (r.s0 + r.s1) * T::HALF);
-        let along_t = (g.point(r.t1, sm) - g.point(r.t0, sm)).norm();
-        let along_s = (g.point(tm, r.s1) - g.point(tm, r.s0)).norm();
-        let (lo, hi) = if along_t >= along_s {
-            (ParamRect { t1: tm, ..r }, ParamRect { t0: tm, ..r })
-        } else {
-            (ParamRect { s1: sm, ..r }, ParamRect { s0: sm, ..r })
+        // Halved across its longer side by arc length; a half below the coordinates'
+        // resolution ends the grading.
+        let cell = Patch::new(g, r)?;
+        let lengths = crate::adaptive::side_lengths(&cell);
+        let (Some(lo), Some(hi)) =
+            (crate::adaptive::half_patch(&cell, lengths, 0), crate::adaptive::half_patch(&cell, lengths, 1))
+        else {
+            break;
         };
+        let (lo, hi) = (lo.rect(), hi.rect());
         let (q_lo, q_hi) = (ratio(lo)?, ratio(hi)?);
         if let (Some(c), Some(q)) = (cells.get_mut(k), ratios.get_mut(k)) {
             *c = lo;
@@ -379,13 +377,8 @@ where
     if !((ba.center - bb.center).norm() - ba.radius - bb.radius < limit) {
         return Ok(false);
     }
-    let centre = |p: &Patch<'_, T, SA>| {
-        let r = p.rect();
-        p.surface().point((r.t0 + r.t1) * T::HALF, (r.s0 + r.s1) * T::HALF)
-    };
-    let r = b.rect();
-    let centre_b = b.surface().point((r.t0 + r.t1) * T::HALF, (r.s0 + r.s1) * T::HALF);
-    let decided = (centre(a) - centre_b).norm() < limit;
+    // An enclosing ball is centred on the surface at the part's parameter centre.
+    let decided = (ba.center - bb.center).norm() < limit;
     if decided || depth >= 2 * MAX_NEAR_DEPTH {
         return Ok(decided);
     }

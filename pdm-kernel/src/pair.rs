@@ -427,10 +427,10 @@ where
     SA: Surface<T> + ?Sized,
     SB: Surface<T> + ?Sized,
 {
-    // Very near (`boundary::very_near`) with exactly one patch flat: the flat one goes inside. A point of
-    // the curved patch sees the flat one cut by one plane (its tangent plane), which the inner
-    // rule places in closed form or brackets as a line; a point of the flat patch may see only
-    // a small cap of the curved one (a sphere cell 1e-3 above a plate: a cap of radius
+    // Very near (`boundary::very_near`) with exactly one patch flat: the flat one goes inside.
+    // A point of the curved patch sees the flat one cut by one plane (its tangent plane), which
+    // the inner rule places in closed form or brackets as a line; a point of the flat patch may
+    // see only a small cap of the curved one (a sphere cell 1e-3 above a plate: a cap of radius
     // √(2·R·gap)), which a probe grid misses. The blind-point count below is a sample count
     // that changes with the order on such a pair.
     if is_flat(a) != is_flat(b) && crate::boundary::very_near(a, b).unwrap_or(false) {
