@@ -84,6 +84,7 @@
 
 use crate::error::PdmError;
 use crate::form_factor::exchange_unchecked;
+use crate::integrand::mutually_facing;
 use crate::patch::Patch;
 use crate::real::Real;
 use crate::samples::PatchSamples;
@@ -771,8 +772,7 @@ pub(crate) fn straddles_curvature_cut<T: Real, const CA: usize, const CB: usize>
     let mut seen_hidden = false;
     for sa in a.iter() {
         for sb in b.iter() {
-            let e = sb.point - sa.point;
-            let visible = sa.unit_normal.dot(e) > T::ZERO && sb.unit_normal.dot(e) < T::ZERO;
+            let visible = mutually_facing(sa.point, sa.unit_normal, sb.point, sb.unit_normal);
             seen_visible |= visible;
             seen_hidden |= !visible;
             if seen_visible && seen_hidden {

@@ -59,6 +59,7 @@
 
 use crate::error::PdmError;
 use crate::gauss::GaussRule;
+use crate::integrand::{self, kernel, mutually_facing};
 use crate::patch::Patch;
 use crate::real::Real;
 use crate::samples::{Ball, PatchSamples};
@@ -296,7 +297,7 @@ where
                     if let (Some(&qx), Some(&qy), Some(&qz), Some(&ax), Some(&ay), Some(&az), Some(&wk)) =
                         (x.get(k), y.get(k), z.get(k), nx.get(k), ny.get(k), nz.get(k), w.get(k))
                     {
-                        sum += wk * kernel_unoccluded(p, np, vec3(qx, qy, qz), vec3(ax, ay, az));
+                        sum += wk * kernel(p, np, vec3(qx, qy, qz), vec3(ax, ay, az));
                     }
                 }
                 count.set(count.get().saturating_add(w.len() as u64));
@@ -515,8 +516,8 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
         let corners = [(r.t0, r.s0), (r.t1, r.s0), (r.t0, r.s1), (r.t1, r.s1)];
         let (mut sees, mut ahead_of_p, mut ahead_of_q) = (0usize, 0usize, 0usize);
         for (t, s) in corners {
-            let e = o + et.scale(t) + es.scale(s) - p;
-            let (towards_q, towards_p) = (np.dot(e) > T::ZERO, nq.dot(e) < T::ZERO);
+            let (ca, cb, _) = integrand::cosines(p, np, o + et.scale(t) + es.scale(s), nq);
+            let (towards_q, towards_p) = (ca > T::ZERO, cb > T::ZERO);
             sees += usize::from(towards_q && towards_p);
             ahead_of_p += usize::from(towards_q);
             ahead_of_q += usize::from(towards_p);
@@ -533,8 +534,7 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
     /// Both facing tests and the occluders for the segment p → q.
     fn visible(&self, p: Vec3<T>, np: Vec3<T>, q: Vec3<T>, nq: Vec3<T>) -> bool {
         self.tick();
-        let e = q - p;
-        np.dot(e) > T::ZERO && nq.dot(e) < T::ZERO && !(self.use_occluders && self.occluders.blocks(p, q))
+        mutually_facing(p, np, q, nq) && !(self.use_occluders && self.occluders.blocks(p, q))
     }
 
     /// The polynomials in t whose roots contain every visibility change on the t-line at s
@@ -813,7 +813,7 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
             for (xt, wt) in self.rule.points() {
                 let (q, nq) = self.surface.point_and_normal(r.t0 + ht * (xt + T::ONE), s);
                 if self.visible(p, np, q, nq) {
-                    sum += ws * wt * kernel_unoccluded(p, np, q, nq);
+                    sum += ws * wt * kernel(p, np, q, nq);
                 }
             }
         }
@@ -881,7 +881,7 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
                     for (xt, wt) in self.rule.points() {
                         let (q, nq) = self.surface.point_and_normal(lo + half * (xt + T::ONE), s);
                         self.tick();
-                        piece += wt * kernel_unoccluded(p, np, q, nq);
+                        piece += wt * kernel(p, np, q, nq);
                     }
                     sum += piece * half;
                 }
@@ -1297,18 +1297,4 @@ fn bisect<T: Real, K: PartialEq + Copy>(f: &impl Fn(T) -> K, mut lo: T, mut hi: 
         }
     }
     (lo, hi, f_hi)
-}
-
-/// (n̂_p·e)(−n_q·e)/L⁴ with n_q unnormalised (area element), clamped at the facing boundary.
-#[inline(always)]
-fn kernel_unoccluded<T: Real>(p: Vec3<T>, np: Vec3<T>, q: Vec3<T>, nq: Vec3<T>) -> T {
-    let e = q - p;
-    let l2 = e.norm2();
-    let ca = np.dot(e).max(T::ZERO);
-    let cb = (-nq.dot(e)).max(T::ZERO);
-    if !(l2 > T::ZERO) {
-        return T::ZERO;
-    }
-    let inv = T::ONE / l2;
-    (ca * inv) * (cb * inv)
 }

@@ -23,6 +23,7 @@
 
 use crate::error::PdmError;
 use crate::gauss::GaussRule;
+use crate::integrand;
 use crate::patch::{Patch, PatchGrid};
 use crate::real::Real;
 use crate::samples::{Ball, PatchSamples};
@@ -343,31 +344,12 @@ const LANES: usize = 8;
 type Columns<'c, T> = (&'c [T], &'c [T], &'c [T], &'c [T], &'c [T], &'c [T], &'c [T]);
 
 /// One term of the sum: w_b (n̂_a·e/L²)(−n̂_b·e/L²) if the pair passes both curvature tests
-/// (sections 3.1–3.2), else 0; branch-free.
+/// (sections 3.1–3.2), else 0; branch-free ([`integrand::term`]).
 #[inline(always)]
 fn term<T: Real>(p: [T; 3], n: [T; 3], q: [T; 3], m: [T; 3], wb: T) -> T {
-    let [px, py, pz] = p;
-    let [nx, ny, nz] = n;
-    let (dx, dy, dz) = (q[0] - px, q[1] - py, q[2] - pz);
-    let l2 = dx * dx + dy * dy + dz * dz;
-    let ca = nx * dx + ny * dy + nz * dz;
-    let cb = -(m[0] * dx + m[1] * dy + m[2] * dz);
-    // l2 > 0 excludes coincident points (a patch against itself at the same node).
-    // Where the CPU has packed floating point (x86 SSE2, AArch64 NEON) the non-short-circuit
-    // `&` leaves no branch, and LLVM turns the lanes into one packed loop body (3.2× in f32,
-    // 2× in f64, BENCHMARKS.md). Elsewhere (Cortex-M FPU, wasm without simd128) nothing is
-    // packed and the branchy form is 96 B smaller in flash.
-    #[cfg(any(target_arch = "x86_64", target_arch = "x86", target_arch = "aarch64"))]
-    let visible = (ca > T::ZERO) & (cb > T::ZERO) & (l2 > T::ZERO);
-    #[cfg(not(any(target_arch = "x86_64", target_arch = "x86", target_arch = "aarch64")))]
-    let visible = ca > T::ZERO && cb > T::ZERO && l2 > T::ZERO;
-    let inv = T::ONE / if visible { l2 } else { T::ONE };
-    let value = wb * (ca * inv) * (cb * inv);
-    if visible {
-        value
-    } else {
-        T::ZERO
-    }
+    let v = |c: [T; 3]| crate::vec3::vec3(c[0], c[1], c[2]);
+    let (ca, cb, l2) = integrand::cosines(v(p), v(n), v(q), v(m));
+    integrand::term(wb, ca, cb, l2)
 }
 
 /// Inner sum without occluders, in `LANES` independent partial sums.

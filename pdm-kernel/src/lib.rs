@@ -67,6 +67,7 @@ pub mod error;
 pub mod fixed;
 pub mod form_factor;
 pub mod gauss;
+mod integrand;
 mod math;
 pub mod pair;
 pub mod patch;

@@ -37,6 +37,7 @@ use crate::adaptive::straddles_curvature_cut;
 use crate::boundary::boundary_unchecked;
 use crate::error::PdmError;
 use crate::form_factor::exchange_unchecked;
+use crate::integrand::mutually_facing;
 use crate::patch::Patch;
 use crate::real::Real;
 use crate::samples::PatchSamples;
@@ -499,12 +500,7 @@ where
 fn blind_points<T: Real, const CAP: usize>(outer: &PatchSamples<T, CAP>, inner: &PatchSamples<T, CAP>) -> usize {
     outer
         .iter()
-        .filter(|p| {
-            !inner.iter().any(|q| {
-                let e = q.point - p.point;
-                p.unit_normal.dot(e) > T::ZERO && q.unit_normal.dot(e) < T::ZERO
-            })
-        })
+        .filter(|p| !inner.iter().any(|q| mutually_facing(p.point, p.unit_normal, q.point, q.unit_normal)))
         .count()
 }
 

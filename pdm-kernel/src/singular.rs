@@ -78,6 +78,7 @@
 
 use crate::error::PdmError;
 use crate::gauss::GaussRule;
+use crate::integrand::kernel_occluded;
 use crate::patch::Patch;
 use crate::real::Real;
 use crate::surface::Surface;
@@ -692,7 +693,7 @@ where
                                 };
                                 let (pa, na) = l.eval(xt, xs);
                                 let (pb, nb) = l.eval(xt + z_t, ys);
-                                inner += wt * ws * kernel(pa, na, pb, nb, occ);
+                                inner += wt * ws * kernel_occluded(pa, na, pb, nb, occ);
                             }
                         }
                         count = count.saturating_add(q2);
@@ -728,9 +729,9 @@ pub(crate) fn faces_itself_mixed<T: Real, S: Surface<T> + ?Sized>(patch: &Patch<
                     continue;
                 }
                 let (q, m) = l.eval(xq, yq);
-                let e = q - p;
-                let (ca, cb) = (n.dot(e), -m.dot(e));
-                let (sa, sb) = (tol * n.norm() * e.norm(), tol * m.norm() * e.norm());
+                let (ca, cb, _) = crate::integrand::cosines(p, n, q, m);
+                let l = (q - p).norm();
+                let (sa, sb) = (tol * n.norm() * l, tol * m.norm() * l);
                 toward |= ca > sa || cb > sb;
                 away |= ca < -sa || cb < -sb;
                 if toward && away {
@@ -858,21 +859,6 @@ fn at<T: Real, const N: usize>(v: &[T; N], k: usize) -> T {
     v.get(k).copied().unwrap_or(T::ZERO)
 }
 
-/// The kernel (n_a·e)(−n_b·e)/L⁴ with unnormalised (Jacobian-scaled) normals, zero where the
-/// curvature test or an occluder says the points do not see each other.
-#[inline(always)]
-fn kernel<T: Real, O: Occluder<T> + ?Sized>(pa: Vec3<T>, na: Vec3<T>, pb: Vec3<T>, nb: Vec3<T>, occluders: &O) -> T {
-    let e = pb - pa;
-    let l2 = e.norm2();
-    let ca = na.dot(e);
-    let cb = -nb.dot(e);
-    if !(ca > T::ZERO && cb > T::ZERO && l2 > T::ZERO) || occluders.blocks(pa, pb) {
-        return T::ZERO;
-    }
-    let inv = T::ONE / l2;
-    (ca * inv) * (cb * inv)
-}
-
 #[allow(clippy::too_many_arguments)]
 fn edge_sum<T, SA, SB, O>(
     a: &Local<'_, '_, T, SA>,
@@ -970,10 +956,10 @@ where
                                         // u < 0: ξ_b = σ(1−|u|), ξ_a = ξ_b + |u|.
                                         let (pa, na) = a.eval(lo, eta_a);
                                         let (pb, nb) = b.eval(lo + abs_u, eta_b);
-                                        let mut k = kernel(pa, na, pb, nb, occ);
+                                        let mut k = kernel_occluded(pa, na, pb, nb, occ);
                                         let (pa2, na2) = a.eval(lo + abs_u, eta_a);
                                         let (pb2, nb2) = b.eval(lo, eta_b);
-                                        k += kernel(pa2, na2, pb2, nb2, occ);
+                                        k += kernel_occluded(pa2, na2, pb2, nb2, occ);
                                         line += ws * k;
                                     }
                                     total.add(wz * wp * wq * jac * span * line);
@@ -1202,7 +1188,7 @@ where
                             };
                             let (pa, na) = a.eval(at(&x, 0), at(&x, 1));
                             let (pb, nb) = b.eval(at(&x, 2), at(&x, 3));
-                            line += wr * kernel(pa, na, pb, nb, occ);
+                            line += wr * kernel_occluded(pa, na, pb, nb, occ);
                         }
                         total.add(wz * wp * wq * jac * line);
                     }
@@ -1323,7 +1309,7 @@ where
                                         };
                                         let (pa, na) = a.eval(at(&x, 0), at(&x, 1));
                                         let (pb, nb) = b.eval(at(&x, 2), at(&x, 3));
-                                        total.add(wz * wp * wq * wr * jac * kernel(pa, na, pb, nb, occ));
+                                        total.add(wz * wp * wq * wr * jac * kernel_occluded(pa, na, pb, nb, occ));
                                     }
                                 }
                             }

@@ -26,14 +26,7 @@ use crate::samples::Ball;
 use crate::surface::{Cylinder, Disk, Parallelogram, Sphere};
 use crate::vec3::Vec3;
 
-/// The two-sided curvature test of sections 3.1–3.2: `true` iff n_a·(p_b − p_a) > 0 and
-/// n_b·(p_a − p_b) > 0.
-#[inline(always)]
-#[must_use]
-pub fn mutually_facing<T: Real>(p_a: Vec3<T>, n_a: Vec3<T>, p_b: Vec3<T>, n_b: Vec3<T>) -> bool {
-    let d = p_b - p_a;
-    n_a.dot(d) > T::ZERO && n_b.dot(d) < T::ZERO
-}
+pub use crate::integrand::mutually_facing;
 
 /// Something that may block the line of sight between two points.
 ///
