@@ -404,7 +404,7 @@ fn edge_case_strategy() -> impl Strategy<Value = EdgeCase> {
     let shape = prop_oneof![
         // w = h, any dihedral angle
         (1.0..=179.0f64, Just(0.0)),
-        // w ≠ h, any dihedral angle (was ≥ 30° until finding 2 was fixed)
+        // w ≠ h, any dihedral angle
         (1.0..=179.0f64, -LOG10_2..=LOG10_2),
     ];
     (shape, -2.0 * LOG10_2..=4.0f64, gap_strategy(), motion_strategy(), 0..8u8, 0..8u8).prop_map(
@@ -520,10 +520,9 @@ fn check_edge_case(case: &EdgeCase, stats: &mut Stats) -> Result<(), TestCaseErr
     let reference = contour::polygon_form_factor(&pf, &pp);
     let e = rel(f, reference);
     stats.see("vs contour", e);
-    // Nearly folded and nearly touching pairs used to be ≈ 1.6e-2·gap off (finding 3), and the
-    // gap entered the tolerance; neighbouring cells along a nearly folded edge (θ < 10°, sharing
-    // a vertex) were 1.6e-6 off at order 20 and 2° (finding 5), allowed 5e-6. Since the ratio
-    // grading follows the peak (edge and vertex transforms) neither needs an allowance.
+    // Nearly folded and nearly touching pairs, and neighbouring cells along a nearly folded edge
+    // (θ < 10°, sharing a vertex), need no allowance of their own: the ratio grading of the edge
+    // and vertex transforms follows the peak (FUZZING.md findings 3 and 5).
     let allowed = 1e-9;
     prop_assert!(e <= allowed, "F = {f:.15e}, contour {reference:.15e}: relative error {e:.2e} > {allowed:.1e}");
 
@@ -680,9 +679,8 @@ fn check_vertex_case(case: &VertexCase, stats: &mut Stats) -> Result<(), TestCas
     let e = rel(f_ab, reference);
     stats.see("vs contour", e);
     // Sizes up to 1 : 3.4 at 30° (an edge of each patch leaving the vertex 30° apart) were
-    // 3.3e-6 off at order 20 before the transform scaled its variables by the side lengths;
-    // 1.2e-12 since (CI seed), 1e-9 allowed.
-    // (The 2e-2·gap term of finding 3 was dropped with its fix: gapped cases are within 1e-9.)
+    // The transform scales its variables by the side lengths: 1.2e-12 on the CI seed, gapped
+    // cases included; 1e-9 allowed.
     let allowed = 1e-9;
     prop_assert!(e <= allowed, "F = {f_ab:.15e}, contour {reference:.15e}: {e:.2e} > {allowed:.1e}");
     // f32, same orders as a cheaper f64 run.

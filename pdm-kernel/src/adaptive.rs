@@ -57,10 +57,9 @@
 //!   at orders p and p + 1 (both levels refined: the inner rule's order is the outer one's);
 //!   the split at p + 1 is returned, and the estimate is 2 × the largest difference between
 //!   the split at p + 1 and the other three and between the split at p and the two wholes.
-//!   Measured on 432 (geometry, order) cases with a cylinder occluder (parallel squares,
-//!   walls inside a coaxial tube; references in closed form up to a 1-D integral): the
-//!   largest |actual error| / difference was 1.01 outside the rounding level (the earlier
-//!   estimate, the split at p against the whole at p and p + 1, reached 3.0).
+//!   On 432 (geometry, order) cases with a cylinder occluder (parallel squares, walls inside
+//!   a coaxial tube; references in closed form up to a 1-D integral) the largest |actual
+//!   error| / difference is 1.01 outside the rounding level, hence the factor 2.
 //! * The same patch twice ([`Adjacency::Identical`]) by the identical-panel transform
 //!   ([`crate::singular`]): without an occluder that may cut the patch's view of itself, as a
 //!   touching pair (orders 4, 6, …, both copies split 2 × 2 at `max_order`; a quarter of a

@@ -32,10 +32,9 @@
 //! point/face/radius cases at order 24). What remains non-smooth is the **outer** integrand
 //! J(p), on curves of face a where a shadow boundary becomes tangent to an edge of b or passes
 //! through a corner; the outer rule samples across them (algebraic convergence), which patch
-//! grids (and the 2 × 2 split in [`crate::pair`]) reduce. Placing those curves into the outer
-//! rule as well was tried (bracketing the count of inner singular points along outer t-lines
-//! converges along each line, but the outer s-level has curves parallel to the t-lines and
-//! costs 10× the time) and is not in this version.
+//! grids (and the outer split in [`crate::pair`]) reduce. The outer rule does not place those
+//! curves: bracketing the count of inner singular points along outer t-lines converges along
+//! each line, but the outer s-level then meets curves parallel to the t-lines, at 10× the time.
 //!
 //! Per outer point p the machinery runs only where it is needed: if no occluder meets the cone
 //! of segments from p to b's bounding ball ([`Occluder::may_block_between`] with p as a ball of

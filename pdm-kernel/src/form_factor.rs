@@ -10,10 +10,10 @@
 //! where w = (Gauss weights)·(Jacobian)·|n| comes from [`PatchSamples`] and only pairs that pass
 //! the two-sided curvature test and are not occluded count (section 3).
 //!
-//! **Overflow/underflow.** The term is evaluated as w_l · (n̂_k·e / L²) · (−n̂_l·e / L²): each
-//! factor scales like 1/length and w like length², so nothing is formed whose exponent grows
-//! with the fourth power of the scale; the result is unchanged (to a few ulps) for geometry
-//! scaled by 1e-12…1e12 in f64 and 1e-4…1e4 in f32 (tested).
+//! The term of the sum and the curvature test are the kernel's one integrand (`integrand.rs`),
+//! evaluated as w_l · (n̂_k·e / L²) · (−n̂_l·e / L²) so that nothing overflows: the result is
+//! unchanged (to a few ulps) for geometry scaled by 1e-12…1e12 in f64 and 1e-4…1e4 in f32
+//! (tested).
 //!
 //! **Accuracy.** For patches well separated relative to their size (distance/size ≳ 2) the sum
 //! converges exponentially with the order; a few digits at order 5, near machine precision by

@@ -278,11 +278,9 @@ fn shortest_edge<T: Real>(c: &[Vec3<T>; 4], collapsed: T) -> T {
 /// Measured (f32 against f64, touching flat pairs, 1°…163°, aspect up to 1 : 556, coordinates
 /// 1…100 sizes from the origin): the relative error is ≈ 0.01…0.075 × q, q = band / (shortest
 /// edge × min(1, fold)), at every angle and aspect — the rounding of the corners moves the
-/// shared edge by ε × magnitude. At 1/32 (608e327) that allowed ≈ 2e-3: seed 20260601 found a
-/// 0.013 × 0.12 floor under a 7.2-high flap at 163°, coordinates ≈ 3300 shortest edges
-/// (q = 6.6e-3), 2.6e-4 off f64 and 2.7e-4 from reciprocal as `Ok`. At 1/1024 the error of an
-/// accepted f32 pair is ≤ ≈ 7e-5 (< 1e-4); f32 pairs at 90° are accepted up to coordinates ≈ 500
-/// shortest edges, at 1° up to ≈ 9 (f64: 4e12 and 7e10).
+/// shared edge by ε × magnitude. At 1/1024 the error of an accepted f32 pair is ≤ ≈ 7e-5
+/// (< 1e-4); f32 pairs at 90° are accepted up to coordinates ≈ 500 shortest edges, at 1° up to
+/// ≈ 9 (f64: 4e12 and 7e10).
 const RESOLUTION: f64 = 1.0 / 1024.0;
 
 /// Adjacency at the tight tolerance (`near` = false: [`adjacency_tolerance`] × patch size) or the
@@ -335,9 +333,9 @@ where
     // fold parameter for an edge pair); otherwise a contact found is reported with the gap `T::MAX`
     // (refused by touching_exchange).
     // Each patch as a whole must be resolved too: edges below the tight tolerance are skipped
-    // as collapsed (a pole), so a patch smaller than the rounding of its coordinates (a sphere of
-    // radius 2.5e-29 at x = −85, `cargo fuzz`) would otherwise pass on the other patch's edges
-    // alone and send rounding noise through the graded transforms (a 30 s timeout).
+    // as collapsed (a pole), so a patch smaller than the rounding of its coordinates (a tiny
+    // sphere far from the origin) would otherwise pass on the other patch's edges alone and send
+    // rounding noise through the graded transforms.
     let smallest_patch = diameter(&ca).min(diameter(&cb));
     // A near contact whose geometry is resolved but whose fold parameter is not (two parallel
     // patches facing each other across a small gap, edge above edge: nearly coincident rather
