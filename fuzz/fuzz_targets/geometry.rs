@@ -19,11 +19,8 @@
 
 use arbitrary::Arbitrary;
 use libfuzzer_sys::fuzz_target;
-use pdm_kernel::{
-    adaptive_exchange, classify, classify_near, form_factor_between, pair_exchange, self_form_factor, surface_form_factor,
-    touching_exchange, vec3, Adjacency, AnyOccluder, BezierPatch, Cone, Cylinder, Disk, Frame, PairSettings,
-    Adaptive, Parallelogram, ParamRect, Patch, PatchGrid, PdmError, Quadrature, Real, Side, Sphere, SquareMap, Surface, Vec3,
-};
+use pdm_kernel::{adaptive_exchange, form_factor_between, pair_exchange, self_form_factor, surface_form_factor, vec3, AnyOccluder, BezierPatch, Cone, Cylinder, Disk, Frame, PairSettings, Adaptive, Parallelogram, ParamRect, Patch, PatchGrid, PdmError, Quadrature, Real, Side, Sphere, Surface, Vec3};
+use pdm_kernel::internals::{classify, classify_near, touching_exchange, Adjacency, SquareMap};
 
 /// Sample capacity: (order + 1)² for order ≤ 6 (the self integral uses order + 1).
 const CAP: usize = 49;

@@ -19,7 +19,8 @@ use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use pdm_host::reference::closed_form::{coaxial_disks, parallel_rectangles};
-use pdm_kernel::{classify_near, pair_exchange, touching_exchange, vec3, Disk, PairSettings, Parallelogram, Patch};
+use pdm_kernel::internals::{classify_near, touching_exchange};
+use pdm_kernel::{pair_exchange, vec3, Disk, PairSettings, Parallelogram, Patch};
 
 const C14: f64 = 0.200_043_776_075_403_16;
 

@@ -46,10 +46,10 @@ use std::cell::RefCell;
 use std::f64::consts::{LOG10_2, PI};
 
 use pdm_host::reference::{closed_form, contour};
+use pdm_kernel::internals::{classify, classify_near, touching_exchange, Adjacency};
 use pdm_kernel::{
-    adaptive_exchange, classify, classify_near, pair_exchange, touching_exchange, vec3, Adaptive, Adjacency, Cylinder,
-    Disk, Flipped, Frame, PairSettings, Parallelogram, ParamRect, Patch, PatchGrid, PdmError, Real, Side, Sphere,
-    Surface, Vec3,
+    adaptive_exchange, pair_exchange, vec3, Adaptive, Cylinder, Disk, Flipped, Frame, PairSettings, Parallelogram,
+    ParamRect, Patch, PatchGrid, PdmError, Real, Side, Sphere, Surface, Vec3,
 };
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, RngSeed, TestCaseError, TestError, TestRunner};
@@ -1185,7 +1185,10 @@ fn fuzz_caller_supplied_subnormal_gap_is_slow() {
     // 1.6e19 twice, a forced SharedEdge with identity maps, gap 5.6e-320, order 7.
     let sphere = Sphere::inner(vec3(-0.5, 255.0, 57.0), f64::from(f32::from_bits(1_597_087_392))).unwrap();
     let a = Patch::whole(&sphere).unwrap();
-    let adjacency = Adjacency::SharedEdge { a: pdm_kernel::SquareMap::IDENTITY, b: pdm_kernel::SquareMap::IDENTITY };
+    let adjacency = Adjacency::SharedEdge {
+        a: pdm_kernel::internals::SquareMap::IDENTITY,
+        b: pdm_kernel::internals::SquareMap::IDENTITY,
+    };
     let start = std::time::Instant::now();
     let x = touching_exchange(&a, &a, adjacency, f64::from_bits(11434), 7, &());
     let t = start.elapsed().as_secs_f64();

@@ -10,7 +10,8 @@
 #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
 
 use pdm_host::reference::cube::blocked_point_factor;
-use pdm_kernel::{boundary_exchange, vec3, Parallelogram, ParamRect, Patch, Side, Sphere};
+use pdm_kernel::internals::boundary_exchange;
+use pdm_kernel::{vec3, Parallelogram, ParamRect, Patch, Side, Sphere};
 
 const SIDE: f64 = 6.0;
 

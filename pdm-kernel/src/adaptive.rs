@@ -2,7 +2,7 @@
 //!
 //! [`adaptive_exchange`] returns A_a·F_{a→b} with an error estimate, whether that estimate met
 //! the tolerance, and the number of integrand evaluations it took. Per pair it
-//! 1. classifies the pair ([`classify_near`]): flat pairs that see each other wholly use the
+//! 1. classifies the pair (`classify_near`): flat pairs that see each other wholly use the
 //!    contour form at two orders or more (where its terms cancel beyond the working precision,
 //!    the paths below take the pair if their rules resolve it, else the contour value stands
 //!    with its rounding bound in the estimate);
@@ -13,7 +13,7 @@
 //!    ρ^(−2p) with ρ ≈ 1 + 2d/h, so p₀ = ⌈ln(1/tol) / (2 ln ρ)⌉ (clamped to 2…12);
 //! 3. skips the occlusion tests when no occluder can cut a segment between the two patches'
 //!    bounding balls (`Occluder::may_block_between`), and takes the boundary path
-//!    ([`boundary`](crate::boundary): visibility boundaries placed into the inner rule, the
+//!    (`boundary.rs`: visibility boundaries placed into the inner rule, the
 //!    inner patch refined towards close outer points) when the pair straddles a boundary
 //!    (some sample pairs visible, some not, or an occluder that may cut) or the patches are
 //!    closer than their size; without occluders the patch whose points stay farther from the
@@ -60,8 +60,8 @@
 //!   On 432 (geometry, order) cases with a cylinder occluder (parallel squares, walls inside
 //!   a coaxial tube; references in closed form up to a 1-D integral) the largest |actual
 //!   error| / difference is 1.01 outside the rounding level, hence the factor 2.
-//! * The same patch twice ([`Adjacency::Identical`]) by the identical-panel transform
-//!   ([`crate::singular`]): without an occluder that may cut the patch's view of itself, as a
+//! * The same patch twice (`Adjacency::Identical`) by the identical-panel transform
+//!   (`singular.rs`): without an occluder that may cut the patch's view of itself, as a
 //!   touching pair (orders 4, 6, …, both copies split 2 × 2 at `max_order`; a quarter of a
 //!   tube's inside meets 1e-10 with 2.2e5 evaluations). With one, the shadow makes the
 //!   integrand jump, and on a saddle the facing test puts kinks in it; the convergence is then
@@ -72,7 +72,7 @@
 //!   a coaxial tube: 2.3e-6 actual against an estimate of 4.8e-4).
 //!
 //! * Self and edge pairs whose contact reaches a side collapsed to a point (a cone's apex)
-//!   converge only algebraically ([`crate::singular`]): the same five-order estimate as an
+//!   converge only algebraically (`singular.rs`): the same five-order estimate as an
 //!   occluded self pair, not split (the cells at the apex stay algebraic at every level).
 //!
 //! # Settings
@@ -343,7 +343,7 @@ where
 }
 
 /// The same patch twice by the identical-panel transform
-/// ([`identical_unchecked`](crate::singular)). Without an occluder that may cut the patch's
+/// (`singular::identical_unchecked`). Without an occluder that may cut the patch's
 /// view of itself the kernel is smooth in the transformed variables: orders 4, 6, … as for a
 /// touching pair, splitting both copies 2 × 2 at `max_order`. With one, the shadow makes the
 /// integrand jump, and on a patch that faces itself in some directions and away in others (a
@@ -624,7 +624,7 @@ where
 }
 
 /// A pair that a visibility boundary crosses. The boundaries are placed into the inner rule
-/// ([`crate::boundary_exchange_counted`]), but the outer integrand still has kinks where a boundary
+/// (`boundary.rs`), but the outer integrand still has kinks where a boundary
 /// meets the inner patch's edges, and two Gauss orders can agree there by accident. So the error is estimated from the outer patch whole and split
 /// 2 × 2 at two orders ([`across_leaf`], module docs), and the pair is subdivided further while
 /// the estimate exceeds the tolerance.

@@ -114,7 +114,7 @@ where
 /// capacity `CAP` on the stack: use `CAP ≥ order²`, e.g. 25 for the paper's order 5).
 ///
 /// Where the sum cannot resolve the pair it is not used: patches that touch along an edge or at
-/// a corner, or nearly ([`crate::classify_near`]), the same patch twice, and patches closer than
+/// a corner, or nearly (`classify_near`), the same patch twice, and patches closer than
 /// [`RESOLVED_DISTANCE`] node spacings are integrated by [`crate::pair_exchange`] at the same
 /// order instead (the touching transforms, the self integral, the visibility-boundary path;
 /// `CAP ≥ (order + 1)²` keeps the order on a self pair, else it is lowered by one). The

@@ -58,7 +58,7 @@
 #![cfg_attr(test, allow(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing))]
 
 pub mod adaptive;
-pub mod boundary;
+mod boundary;
 mod bounds;
 #[cfg(feature = "closed-form")]
 mod contour;
@@ -73,7 +73,7 @@ pub mod pair;
 pub mod patch;
 pub mod real;
 pub mod samples;
-pub mod singular;
+mod singular;
 pub mod surface;
 pub mod vec3;
 pub mod visibility;
@@ -84,19 +84,27 @@ pub mod visibility;
 struct ReadmeDoctests;
 
 pub use adaptive::{adaptive_exchange, Adaptive, Estimate};
-pub use boundary::{boundary_exchange, boundary_exchange_counted};
 pub use dual::{Dual, Scalar};
 pub use error::PdmError;
 pub use form_factor::{exchange, form_factor, form_factor_between, self_form_factor, surface_form_factor, Quadrature};
 pub use gauss::{GaussRule, MAX_ORDER};
-pub use pair::{pair_exchange, pair_exchange_counted, PairSettings};
+pub use pair::{pair_exchange, PairSettings};
 pub use patch::{Patch, PatchGrid};
 pub use real::Real;
 pub use samples::{Ball, PatchSamples, Sample};
-pub use singular::{classify, classify_near, touching_exchange, Adjacency, SquareMap};
 pub use surface::{
     AutoNormal, BezierPatch, Cone, Cylinder, Disk, Flipped, Frame, Parallelogram, ParamRect, ParametricMap, Side,
     Sphere, Surface,
 };
 pub use vec3::{vec3, Vec3};
 pub use visibility::{mutually_facing, AnyOccluder, Occluder};
+
+/// The pieces of the pair methods that the workspace's own tests, benches and fuzz targets
+/// reach directly (classification, the touching transforms and the boundary path on their own,
+/// evaluation counts, internal limits). Not part of the API: no semver promise, no docs.
+#[doc(hidden)]
+pub mod internals {
+    pub use crate::boundary::{boundary_exchange, boundary_exchange_counted, MAX_BREAKS, MAX_NEAR_DEPTH, MAX_SPLITS};
+    pub use crate::pair::{pair_exchange_counted, MAX_CONTACT_SPLITS, OCCLUDED_OUTER_SPLIT};
+    pub use crate::singular::{classify, classify_near, touching_exchange, Adjacency, SquareMap, NEAR_CONTACT};
+}

@@ -12,20 +12,20 @@
 //!   vertex. Where its terms cancel beyond half the digits, a
 //!   touching pair falls to the transforms below.
 //! - Other touching pairs (shared edge or vertex, found by
-//!   [`crate::singular::classify_near`], also when they are only nearly touching) use the
-//!   regularising transforms of [`crate::singular`], converging exponentially with
+//!   `classify_near`, also when they are only nearly touching) use the
+//!   regularising transforms of `singular.rs`, converging exponentially with
 //!   `singular_order`.
 //! - A touching pair that an occluder may cut is first split, both patches 2 × 2, until the
-//!   cells along the contact are clear of every occluder (at most [`MAX_CONTACT_SPLITS`]
+//!   cells along the contact are clear of every occluder (at most `MAX_CONTACT_SPLITS`
 //!   levels): a shadow across the pair would put a jump into the transformed integrand. The
 //!   sub-pairs are dispatched as above and below.
-//! - The same patch twice uses the identical-panel transform of [`crate::singular`],
+//! - The same patch twice uses the identical-panel transform of `singular.rs`,
 //!   converging exponentially with `singular_order` on a smooth patch.
 //! - Other separate pairs use the PDM sum at `order`. With `boundaries` on, a pair that
 //!   straddles a back-face cut, that an occluder may cut, or whose patches are closer than
 //!   their size gets the visibility boundaries placed into the inner rule and the inner patch
-//!   refined towards each outer point ([`crate::boundary`]; the outer patch is also split
-//!   [`OCCLUDED_OUTER_SPLIT`]² when an occluder may cut); smooth, distant, unoccludable pairs
+//!   refined towards each outer point (`boundary.rs`; the outer patch is also split
+//!   `OCCLUDED_OUTER_SPLIT`² when an occluder may cut); smooth, distant, unoccludable pairs
 //!   keep the plain sum. Without occluders the outer patch is, for a very near pair with one
 //!   flat patch, the curved one; otherwise the one with fewer points that see none of the
 //!   other, then the one whose points stay farther from the other's edges (`outer_is_b`).
@@ -52,6 +52,7 @@ use crate::visibility::Occluder;
 /// algebraic in the cell size (kinks where a shadow boundary meets the inner patch's corners or
 /// edges), so finer outer cells at a lower order pay: on the paper's cube, 3 × 3 beats 2 × 2 at
 /// equal cost for every radius and grid tried (RESULTS.md, "Within 1e-6 in under a second").
+#[doc(hidden)]
 pub const OCCLUDED_OUTER_SPLIT: usize = 3;
 
 /// Relative overshoot of the physical bounds that [`pair_exchange`] clamps as quadrature error
@@ -97,7 +98,7 @@ impl PairSettings {
 ///   integrand has a layer on the scale of the gap (a peak under the closest point, a step
 ///   where one patch passes over the other's edge). The boundary path cuts the outer patch
 ///   into up to 8 cells graded towards the inner one and puts a flat patch inside
-///   ([`crate::boundary`]); a sphere cell of radius 0.3 whose lowest point is 1e-1, 3e-2 or
+///   (`boundary.rs`); a sphere cell of radius 0.3 whose lowest point is 1e-1, 3e-2 or
 ///   1e-3 above a plate cell near its corner: 6.0e-9 / 5.1e-7 / 1.1e-6 at order 12, 8.3e-10 /
 ///   1.2e-7 / 1.0e-7 at 16 (test `trust::sphere_cell_close_above_a_plate_cell`). Closer still,
 ///   the 8 cells stop resolving the layer: subdivide such pairs towards the contact, or use the
@@ -146,9 +147,10 @@ where
 }
 
 /// [`pair_exchange`] and the work it did, in integrand evaluations: kernel evaluations and
-/// visibility probes on the boundary path ([`crate::boundary_exchange_counted`]), order⁴ for a
+/// visibility probes on the boundary path (`boundary.rs`), order⁴ for a
 /// plain sum and order⁴ more for the straddle check, 6·p⁴ for a shared edge and 4·p⁴ for a
 /// shared vertex (p = `singular_order`), 4·p⁴ for a self pair (times the ζ-shells of long patches).
+#[doc(hidden)]
 pub fn pair_exchange_counted<T, SA, SB, O, const CAP: usize>(
     a: &Patch<'_, T, SA>,
     b: &Patch<'_, T, SB>,
@@ -261,6 +263,7 @@ pub(crate) fn pieces<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>) -> (u
 
 /// Most successive 2 × 2 × 2 × 2 splits of a touching pair that an occluder may cut, before
 /// the touching transforms take the remaining cells along the contact (module docs).
+#[doc(hidden)]
 pub const MAX_CONTACT_SPLITS: u32 = 4;
 
 /// One piece pair, with touching pairs that an occluder may cut split first: the touching
@@ -270,7 +273,7 @@ pub const MAX_CONTACT_SPLITS: u32 = 4;
 /// Both patches are split 2 × 2 and the 16 sub-pairs dispatched anew: the cells along the
 /// contact shrink until no occluder can cut between them (the transforms are then exact), and
 /// the others are separate pairs, which the boundary path integrates with the shadows placed
-/// into its inner rule. After [`MAX_CONTACT_SPLITS`] levels (an occluder that reaches the
+/// into its inner rule. After `MAX_CONTACT_SPLITS` levels (an occluder that reaches the
 /// contact itself), the touching transforms take the remaining cells as they are.
 /// The recursion keeps no sample buffer in its own frame: [`dispatch`] holds them.
 fn split_occluded_contacts<T, SA, SB, O, const CAP: usize>(
@@ -310,7 +313,7 @@ where
     dispatch::<T, SA, SB, O, CAP>(a, b, (adjacency, gap), settings, occluders)
 }
 
-/// One piece pair by the method it needs, given its classification ([`classify_near`]):
+/// One piece pair by the method it needs, given its classification (`classify_near`):
 /// (value, evaluations, bound on the contour form's rounding — zero for the other methods).
 #[inline(never)]
 fn dispatch<T, SA, SB, O, const CAP: usize>(
@@ -503,7 +506,7 @@ fn blind_points<T: Real, const CAP: usize>(outer: &PatchSamples<T, CAP>, inner: 
         .count()
 }
 
-/// The boundary path with the outer patch split [`OCCLUDED_OUTER_SPLIT`]²: shadow edges
+/// The boundary path with the outer patch split `OCCLUDED_OUTER_SPLIT`²: shadow edges
 /// crossing b make the outer integrand kink where they touch b's edges.
 fn occluded<T, SA, SB, O, const CAP: usize>(
     a: &Patch<'_, T, SA>,

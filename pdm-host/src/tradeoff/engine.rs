@@ -276,7 +276,7 @@ where
     Ok(Solution { values, evaluations })
 }
 
-/// `pdm_kernel::pair_exchange_counted` with `PairSettings { order, singular_order: order,
+/// `pdm_kernel::internals::pair_exchange_counted` with `PairSettings { order, singular_order: order,
 /// boundaries: true }`: (A_a F_{a→b}, evaluations), as the kernel counts them (kernel
 /// evaluations and visibility probes on the boundary path, order⁴ for the straddle check and
 /// for a plain sum, 6·order⁴ for a shared edge, 4·order⁴ for a shared vertex). The test
@@ -294,5 +294,5 @@ where
     O: Occluder<T> + ?Sized,
 {
     let settings = PairSettings { order, singular_order: order, boundaries: true };
-    pdm_kernel::pair_exchange_counted::<T, SA, SB, O, CAP>(a, b, settings, occluders)
+    pdm_kernel::internals::pair_exchange_counted::<T, SA, SB, O, CAP>(a, b, settings, occluders)
 }

@@ -3,9 +3,10 @@
 //! `pdm_host::reference::contour` (which shares no code with the kernel's quadrature).
 
 use pdm_host::reference::{closed_form as exact, contour};
+use pdm_kernel::internals::{classify, Adjacency};
 use pdm_kernel::{
-    classify, pair_exchange, vec3, Adjacency, Cylinder, Disk, PairSettings, Parallelogram, Patch, PatchGrid,
-    PatchSamples, Real, Side, Sphere, Surface, Vec3,
+    pair_exchange, vec3, Cylinder, Disk, PairSettings, Parallelogram, Patch, PatchGrid, PatchSamples, Real, Side,
+    Sphere, Surface, Vec3,
 };
 
 fn v<T: Real>(p: [f64; 3]) -> Vec3<T> {

@@ -422,7 +422,7 @@ fn visibility_changes_beyond_every_halving() {
     let half = 0.5 * exact::parallel_rectangles(1.0, 1.0, 1.0);
     // The boundary path itself (pair_exchange would split the outer patch 3 × 3 first, nine
     // times the work for the same check).
-    let got = pdm_kernel::boundary_exchange::<f64, _, _, _, 1024>(&a, &b, 8, &NoisyScreen).unwrap();
+    let got = pdm_kernel::internals::boundary_exchange::<f64, _, _, _, 1024>(&a, &b, 8, &NoisyScreen).unwrap();
     assert!(rel(got, half) < 0.1, "{got} against {half}");
 }
 
