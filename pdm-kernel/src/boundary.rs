@@ -188,7 +188,7 @@ where
 }
 
 /// Most cells into which [`outer_cells`] cuts the outer patch (each costs one outer rule).
-pub(crate) const MAX_OUTER_CELLS: usize = 8;
+pub(crate) const MAX_OUTER_CELLS: usize = 32;
 
 /// The outer patch a cut, by halving across its longer side (arc length), until no cell is
 /// closer to b than its own radius, at most [`MAX_OUTER_CELLS`] cells; the cell closest to b
@@ -343,9 +343,9 @@ fn distance_to_part<T: Real, S: Surface<T> + ?Sized>(
 /// Whether the gap between the patches is below [`VERY_NEAR`] of the smaller one's radius
 /// (enclosing balls). Pairs of parts of the two are refined, the larger part 2 × 2 first: a
 /// pair whose balls are farther apart than that gap is not very near; one whose centre points
-/// (the surfaces at the parts' parameter centres) are closer is. Past [`MAX_NEAR_DEPTH`]
-/// halvings of both, or where a part falls below the coordinates' resolution, the centre points
-/// decide.
+/// (the surfaces at the parts' parameter centres) are closer is. Where the parts' balls are
+/// below [`NEAR_RESOLUTION`] of the limit, past [`MAX_NEAR_DEPTH`] halvings of both, or where
+/// a part falls below the coordinates' resolution, the centre points decide.
 pub(crate) fn very_near<T, SA, SB>(a: &Patch<'_, T, SA>, b: &Patch<'_, T, SB>) -> Result<bool, PdmError>
 where
     T: Real,
@@ -377,9 +377,13 @@ where
     if !((ba.center - bb.center).norm() - ba.radius - bb.radius < limit) {
         return Ok(false);
     }
-    // An enclosing ball is centred on the surface at the part's parameter centre.
+    // An enclosing ball is centred on the surface at the part's parameter centre. Parts whose
+    // balls are small against the limit decide by their centre points: the gap is judged to
+    // within NEAR_RESOLUTION of the limit, which bounds the refinement where the gap is close to
+    // the limit (otherwise every part pair along the whole near region is refined to the depth cap).
     let decided = (ba.center - bb.center).norm() < limit;
-    if decided || depth >= 2 * MAX_NEAR_DEPTH {
+    let resolved = ba.radius + bb.radius < T::from_f64(NEAR_RESOLUTION) * limit;
+    if decided || resolved || depth >= 2 * MAX_NEAR_DEPTH {
         return Ok(decided);
     }
     for k in 0..4 {
@@ -397,6 +401,10 @@ where
     }
     Ok(false)
 }
+
+/// Relative resolution of [`very_near`]'s decision: a gap within this fraction of the limit
+/// may count either way.
+const NEAR_RESOLUTION: f64 = 0.125;
 
 /// The gap, in the smaller patch's radius, below which a pair counts as very near
 /// ([`very_near`]): its outer integrand has a layer on the gap's scale.
