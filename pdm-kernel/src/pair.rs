@@ -97,12 +97,12 @@ impl PairSettings {
 /// - a curved (not flat) patch closer to another patch than the smaller one's size: the outer
 ///   integrand has a layer on the scale of the gap (a peak under the closest point, a step
 ///   where one patch passes over the other's edge). The boundary path cuts the outer patch
-///   into up to 8 cells graded towards the inner one and puts a flat patch inside
+///   into up to 32 cells graded towards the inner one and puts a flat patch inside
 ///   (`boundary.rs`); a sphere cell of radius 0.3 whose lowest point is 1e-1, 3e-2 or
-///   1e-3 above a plate cell near its corner: 6.0e-9 / 5.1e-7 / 1.1e-6 at order 12, 8.3e-10 /
-///   1.2e-7 / 1.0e-7 at 16 (test `trust::sphere_cell_close_above_a_plate_cell`). Closer still,
-///   the 8 cells stop resolving the layer: subdivide such pairs towards the contact, or use the
-///   tolerance mode. Two flat patches take the contour form instead, exact at any gap;
+///   1e-3 above a plate cell near its corner: 6.0e-9 / 1.3e-9 / 1.3e-8 at order 12, 8.3e-10 /
+///   9.3e-10 / 7.4e-9 at 16 (test `trust::sphere_cell_close_above_a_plate_cell`). Much closer
+///   still, the 32 cells stop resolving the layer: subdivide such pairs towards the contact, or
+///   use the tolerance mode. Two flat patches take the contour form instead, exact at any gap;
 /// - self and edge pairs reaching a side that collapses to a point on a concave surface (the
 ///   pieces of a cone's inside at its apex: the whole wall against itself 2.0e-5 off at
 ///   singular order 12, 6.6e-6 at 16; a frustum, without the apex, 8e-11);

@@ -346,6 +346,29 @@ fn f5_tilted_sphere_cells_over_an_off_centre_plate() {
     assert!(rel(&got, reference) < 1e-6, "{got:?} vs {reference}: {:.2e}", rel(&got, reference));
 }
 
+/// A tilted sphere R 0.3 cut 6 × 12 whose lowest point is 1e-2 or 1e-3 above a unit plate cut
+/// 2 × 2, near the plate's corner (the sphere overhangs two of its edges), both argument orders.
+/// Reference: sphere → polygon, F = Ω/(4π) with Ω the plate's solid angle at the centre
+/// (Van Oosterom–Strackee), so A·F = R²·Ω.
+#[test]
+#[ignore = "slow (about 40 s alone): .ci/run runs it, `-- --ignored slow_`"]
+fn slow_tilted_sphere_grid_close_above_a_plate_corner() {
+    let radius = 0.3;
+    for gap in [1e-2, 1e-3] {
+        let centre = [0.95, 0.1, radius + gap];
+        let frame = Frame::from_axis(v([0.3, -0.5, 1.0])).unwrap();
+        let sphere = Sphere::<f64>::with_frame(v(centre), radius, frame, Side::Outer).unwrap();
+        let plate = square::<f64>([0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]);
+        let poly = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
+        let reference = 4.0 * PI * radius * radius * exact::sphere_to_polygon(centre, &poly);
+        let ab = grid_sum(&sphere, (6, 12), &plate, (2, 2), settings(12));
+        let ba = grid_sum(&plate, (2, 2), &sphere, (6, 12), settings(12));
+        let (e_ab, e_ba) = (rel(&ab, reference), rel(&ba, reference));
+        println!("gap {gap:.0e}: {} / reversed {} vs {reference:.15e}: {e_ab:.2e} / {e_ba:.2e}", show(&ab), show(&ba));
+        assert!(e_ab < 1e-6 && e_ba < 1e-6, "gap {gap}: {e_ab:.2e} / {e_ba:.2e}");
+    }
+}
+
 /// F6: the base disk (cut 1 × 4) of a closed cylinder r = 1, h = 0.1 → its inner wall (cut
 /// 4 × 2). Reference: the enclosure sum rule, F_base→wall = 1 − F_base→top with C-41:
 /// A·F = π(1 − C-41(1, 1, 0.1)). Once 6.8e-6 off at order 16.
