@@ -420,7 +420,7 @@ fn algebraic_leaf<T: Real>(
 /// The starting order of a separate pair from its geometry (module docs, item 2), capped at
 /// `max_order`, whether the pair straddles a visibility boundary at that order (or is closer
 /// than its size), and whether b should be the outer patch of the boundary path (unoccluded
-/// pairs, [`crate::pair::outer_is_b`]; across occluders a stays outside).
+/// pairs, `pair::outer_is_b`; across occluders, `pair::occluded_outer_is_b`).
 #[inline(never)]
 fn separate_plan<T, SA, SB, O, const CAP: usize>(
     a: &Patch<'_, T, SA>,
@@ -458,7 +458,8 @@ where
     // compares the outer patch whole and split.
     let occluded = occluders.may_block_between(&ball_a, &ball_b);
     let across = occluded || crate::pair::near(&ball_a, &ball_b) || straddles_curvature_cut(&sa, &sb);
-    let swap = across && !occluded && crate::pair::outer_is_b(a, b, &sa, &sb);
+    let swap = across
+        && if occluded { crate::pair::occluded_outer_is_b(a, b) } else { crate::pair::outer_is_b(a, b, &sa, &sb) };
     Ok((p, across, swap))
 }
 

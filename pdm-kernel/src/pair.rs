@@ -29,6 +29,8 @@
 //!   keep the plain sum. Without occluders the outer patch is, for a very near pair with one
 //!   flat patch, the curved one; otherwise the one with fewer points that see none of the
 //!   other, then the one whose points stay farther from the other's edges (`outer_is_b`).
+//!   Where an occluder may cut, the flat one if only one is flat, else the smaller one
+//!   (`occluded_outer_is_b`). Either way the choice does not depend on the argument order.
 //!
 //! Every value is checked against the physical bounds 0 ≤ A_a·F_{a→b} ≤ min(A_a, A_b) before
 //! it is returned.
@@ -84,13 +86,21 @@ impl PairSettings {
 /// from each point of a), so the two argument orders agree to the quadrature error, not to the
 /// last digit. Divide by A_a ([`Patch::area`]) for F_{a→b}.
 ///
-/// Accuracy at [`PairSettings::ACCURATE`]: about 1e-12 on smooth, touching and flat pairs and
-/// on most pairs straddling a back-face cut. Where the outer integrand has a kink or a layer,
-/// the outer rule converges only algebraically, and this fixed-order method has no estimate
-/// of it:
+/// Accuracy at [`PairSettings::ACCURATE`]: about 1e-12 on smooth, touching and flat pairs.
+/// Where the outer integrand has a kink or a layer, the outer rule converges only
+/// algebraically, and this fixed-order method has no estimate of it:
+/// - a curved patch straddling the back-face cut of the other: the inner integral is exact,
+///   but the outer integrand kinks where the visible part's boundary passes through a corner
+///   of the inner patch or touches one of its edges. Where those curves miss the outer
+///   patch's nodes or line up with its edges the pair is exact (an upright sphere cut 2 × 4
+///   above a plate: 5e-16); elsewhere it is 1e-8 to 1e-6 on whole surfaces at order 16 (the
+///   same sphere tilted: 1.6e-6 against the plate whole, 6.3e-8 cut 2 × 2) and worse for
+///   single pairs (a sphere quarter against a disk quarter: 2.6e-4 at order 12; over the
+///   whole sphere and disk such errors cancel to 1e-13). Finer grids reduce it;
 /// - across occluders (a shadow edge meeting the inner patch's corners and edges): about 1e-7
 ///   to 1e-5 relative (a sphere inside a box, the floor's row to the other faces: 1.3e-6 at
-///   order 12, 1.2e-6 at 16); an occluder that cuts through the outer patch itself makes the
+///   order 12, 1.2e-6 at 16; a tube between a small square and a large one: 2.1e-5 at 16,
+///   its shadow's boundaries bisected rather than solved); an occluder that cuts through the outer patch itself makes the
 ///   outer integrand jump along the cut, and the outer rule converges only like 1/order (a
 ///   partition plate through two parallel rectangles, dividing both: 7.8e-4 at order 12,
 ///   5.1e-4 at 16; split the patches along the cut, or use the tolerance mode);
@@ -368,9 +378,7 @@ where
             let may_occlude = occluders.may_block_between(&sa.bounds(), &sb.bounds())
                 || occluders.may_block_between(&a.enclosing_ball(), &b.enclosing_ball());
             if may_occlude {
-                // The inner rule is in closed form only on a flat (affine) inner patch: put it
-                // inside when only one of the two is flat.
-                if has_affine_map(b) || !has_affine_map(a) {
+                if !occluded_outer_is_b(a, b) {
                     occluded::<T, SA, SB, O, CAP>(a, b, settings.order, occluders).map(exact)
                 } else {
                     occluded::<T, SB, SA, O, CAP>(b, a, settings.order, occluders).map(exact)
@@ -407,6 +415,26 @@ where
     let sa = PatchSamples::<T, CAP>::new(a, order)?;
     let sb = PatchSamples::<T, CAP>::new(b, order)?;
     Ok(crate::form_factor::samples_resolved(&sa, order, &sb, order))
+}
+
+/// Which patch of a pair an occluder may cut the boundary path should integrate outside
+/// (`true`: b). The inner rule is in closed form only on a flat (affine) inner patch: when only
+/// one of the two is flat, it goes inside. Otherwise the smaller one (enclosing ball) goes
+/// outside: the outer integrand kinks where a shadow boundary on the inner patch meets that
+/// patch's corners and edges, and jumps where an occluder cuts the outer patch itself; on the
+/// larger inner patch a shadow more often lies wholly inside, and the smaller outer patch is
+/// less often cut. It also makes the choice independent of the argument order.
+pub(crate) fn occluded_outer_is_b<T, SA, SB>(a: &Patch<'_, T, SA>, b: &Patch<'_, T, SB>) -> bool
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+{
+    let (flat_a, flat_b) = (has_affine_map(a), has_affine_map(b));
+    if flat_a != flat_b {
+        return flat_a;
+    }
+    b.enclosing_ball().radius < a.enclosing_ball().radius
 }
 
 /// Which patch of a separate, unoccluded pair the boundary path should integrate outside

@@ -369,6 +369,24 @@ fn slow_tilted_sphere_grid_close_above_a_plate_corner() {
     }
 }
 
+/// The inner wall of a frustum (r 1 → 0.5, h 1) cut 4 × 2 against the whole base disk it
+/// stands on, both argument orders. From every wall point the base's rim touches the line where
+/// the tangent plane meets the base plane, and the upper cells are within their own size of
+/// the base: deciding whether such a pair is very near once refined every pair of parts along
+/// the rim to the depth cap (one cell did not finish in 240 s). Reference: the enclosure sum
+/// rule with C-41, A·F_base→wall = π(1 − F_base→top).
+#[test]
+fn frustum_wall_cells_to_the_base_they_stand_on() {
+    let base = Disk::<f64>::new(v([0.0, 0.0, 0.0]), v([0.0, 0.0, 1.0]), 1.0).unwrap();
+    let wall = Cone::<f64>::new(v([0.0, 0.0, 0.0]), v([0.0, 0.0, 1.0]), 1.0, 0.5, 1.0, Side::Inner).unwrap();
+    let reference = PI * (1.0 - exact::coaxial_disks(1.0, 0.5, 1.0));
+    let ab = grid_sum(&wall, (4, 2), &base, (1, 1), settings(12));
+    let ba = grid_sum(&base, (1, 1), &wall, (4, 2), settings(12));
+    let (e_ab, e_ba) = (rel(&ab, reference), rel(&ba, reference));
+    println!("wall 4x2 -> base: {} / reversed {} vs {reference:.15e}: {e_ab:.2e} / {e_ba:.2e}", show(&ab), show(&ba));
+    assert!(e_ab < 1e-9 && e_ba < 1e-9, "{e_ab:.2e} / {e_ba:.2e}");
+}
+
 /// F6: the base disk (cut 1 × 4) of a closed cylinder r = 1, h = 0.1 → its inner wall (cut
 /// 4 × 2). Reference: the enclosure sum rule, F_base→wall = 1 − F_base→top with C-41:
 /// A·F = π(1 − C-41(1, 1, 0.1)). Once 6.8e-6 off at order 16.
