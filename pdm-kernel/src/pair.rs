@@ -81,10 +81,12 @@ impl PairSettings {
 
 /// A_a·F_{a→b} for any two patches, by the method the pair needs (see the module docs).
 ///
-/// The quantity is symmetric (A_a·F_{a→b} = A_b·F_{b→a}); the computation is not quite: on
-/// the boundary path a is integrated outside (its Gauss points) and b inside (its visible part
-/// from each point of a), so the two argument orders agree to the quadrature error, not to the
-/// last digit. Divide by A_a ([`Patch::area`]) for F_{a→b}.
+/// The quantity is symmetric (A_a·F_{a→b} = A_b·F_{b→a}), and so, mostly, is the computation:
+/// on the boundary path one patch is integrated outside (its Gauss points) and the other inside
+/// (its visible part from each outer point), chosen from the geometry (module docs), so both
+/// argument orders give the same value; where the geometry leaves a tie (two equal patches), a
+/// goes outside and the two orders agree to the quadrature error. Divide by A_a
+/// ([`Patch::area`]) for F_{a→b}.
 ///
 /// Accuracy at [`PairSettings::ACCURATE`]: about 1e-12 on smooth, touching and flat pairs.
 /// Where the outer integrand has a kink or a layer, the outer rule converges only
