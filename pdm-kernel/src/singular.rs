@@ -62,7 +62,10 @@
 //!
 //! **Nearly touching** pairs (an edge or corner closer than the patch size but not shared) are
 //! handled by the same transforms with the ζ-interval split geometrically down to the gap, so the
-//! near-singular peak is resolved (error bounded independently of the gap).
+//! near-singular peak is resolved (error bounded independently of the gap). A near edge whose
+//! gap tapers along it (the edges nearly meet at one end and diverge at a small angle: cells
+//! side by side across a small fold) peaks at ζ ≈ the local gap: ζ is split from the narrow
+//! end's gap and the variable along the edge is graded towards that end (`Taper`).
 //!
 //! Adjacency is detected from the geometry ([`classify`], [`classify_near`]): one to one, the
 //! single best match — the edge of A and edge of B (either direction) whose end points are
@@ -560,10 +563,13 @@ where
             ];
             let (ext, r0) = extents(lengths);
             let g = if r0 > T::ZERO { gap * scale / r0 } else { gap };
+            let taper = if g > T::ZERO { Taper::of(&la, &lb, r0) } else { None };
+            // A tapered gap grades ζ from its narrow end.
+            let g = taper.map_or(g, |t| t.narrow);
             if occluded {
-                edge_sum(&la, &lb, &rule, occluders, ext, at(&lengths, 0), g, fold)
+                edge_sum(&la, &lb, &rule, occluders, ext, at(&lengths, 0), g, fold, taper)
             } else {
-                edge_sum(&la, &lb, &rule, &(), ext, at(&lengths, 0), g, fold)
+                edge_sum(&la, &lb, &rule, &(), ext, at(&lengths, 0), g, fold, taper)
             }
         }
         Adjacency::SharedVertex { a: ma, b: mb } => {
@@ -857,6 +863,50 @@ fn at<T: Real, const N: usize>(v: &[T; N], k: usize) -> T {
     v.get(k).copied().unwrap_or(T::ZERO)
 }
 
+/// A near edge pair whose gap tapers along the edge: the two edges nearly meet at one end and
+/// diverge towards the other (cells side by side across a small fold, a slightly rotated
+/// neighbour). The near-singular peak then sits at ζ ≈ the local gap, which runs from `narrow`
+/// to `wide` (both in units of the shortest side) along the edge: ζ is split geometrically
+/// from the narrow end's gap, and the variable along the edge is graded towards the narrow end
+/// with the width where the local gap grows by the current ζ.
+#[derive(Clone, Copy, Debug)]
+struct Taper<T> {
+    narrow: T,
+    wide: T,
+    /// The narrow end is at the edge parameter 1 (else 0).
+    at_one: bool,
+}
+
+impl<T: Real> Taper<T> {
+    /// The gaps at both ends of the matched edge (points at parameter 0 and 1 of both local
+    /// maps), in units of `r0`; `None` unless they differ by more than a factor of 2. A narrow
+    /// end below the rounding (the edges meet there) is given 2⁻²⁰ of the wide one, enough
+    /// shells to reach the scales where the rule's nodes stop seeing the difference.
+    fn of<SA, SB>(a: &Local<'_, '_, T, SA>, b: &Local<'_, '_, T, SB>, r0: T) -> Option<Self>
+    where
+        SA: Surface<T> + ?Sized,
+        SB: Surface<T> + ?Sized,
+    {
+        if !(r0 > T::ZERO && r0 < T::MAX) {
+            return None;
+        }
+        let end = |x: T| (a.eval(x, T::ZERO).0 - b.eval(x, T::ZERO).0).norm() / r0;
+        let (g0, g1) = (end(T::ZERO), end(T::ONE));
+        let (lo, hi) = (g0.min(g1), g0.max(g1));
+        if !(hi.is_finite() && hi > T::TWO * lo) {
+            return None;
+        }
+        let floor = hi * T::from_f64(1.0 / 1_048_576.0);
+        Some(Self { narrow: lo.max(floor), wide: hi, at_one: g1 < g0 })
+    }
+
+    /// The grading width along the edge (as a fraction of the line of length `span`) at radial
+    /// distance `zeta`: where the local gap has grown by ζ.
+    fn width(self, zeta: T, span: T) -> T {
+        (zeta + self.narrow) / ((self.wide - self.narrow) * span)
+    }
+}
+
 #[allow(clippy::too_many_arguments)]
 fn edge_sum<T, SA, SB, O>(
     a: &Local<'_, '_, T, SA>,
@@ -867,6 +917,7 @@ fn edge_sum<T, SA, SB, O>(
     edge_length: T,
     gap: T,
     fold: T,
+    taper: Option<Taper<T>>,
 ) -> T
 where
     T: Real,
@@ -948,18 +999,22 @@ where
                                     let (eta_a, eta_b) = ((xa * at(&c, 1)).min(T::ONE), (xb * at(&c, 2)).min(T::ONE));
                                     let span = T::ONE - abs_u;
                                     let mut line = T::ZERO;
-                                    for (sigma, ws) in unit_points(rule) {
-                                        let lo = sigma * span;
-                                        // u > 0: ξ_a = σ(1−u), ξ_b = ξ_a + u;
-                                        // u < 0: ξ_b = σ(1−|u|), ξ_a = ξ_b + |u|.
-                                        let (pa, na) = a.eval(lo, eta_a);
-                                        let (pb, nb) = b.eval(lo + abs_u, eta_b);
-                                        let mut k = kernel_occluded(pa, na, pb, nb, occ);
-                                        let (pa2, na2) = a.eval(lo + abs_u, eta_a);
-                                        let (pb2, nb2) = b.eval(lo, eta_b);
-                                        k += kernel_occluded(pa2, na2, pb2, nb2, occ);
-                                        line += ws * k;
-                                    }
+                                    let (width, toward_one) =
+                                        taper.map_or((T::ONE, false), |t| (t.width(zeta, span), t.at_one));
+                                    for_each_interval(width, toward_one, |l0, l1| {
+                                        for (sigma, ws) in unit_points(rule) {
+                                            let lo = (l0 + (l1 - l0) * sigma) * span;
+                                            // u > 0: ξ_a = σ(1−u), ξ_b = ξ_a + u;
+                                            // u < 0: ξ_b = σ(1−|u|), ξ_a = ξ_b + |u|.
+                                            let (pa, na) = a.eval(lo, eta_a);
+                                            let (pb, nb) = b.eval(lo + abs_u, eta_b);
+                                            let mut k = kernel_occluded(pa, na, pb, nb, occ);
+                                            let (pa2, na2) = a.eval(lo + abs_u, eta_a);
+                                            let (pb2, nb2) = b.eval(lo, eta_b);
+                                            k += kernel_occluded(pa2, na2, pb2, nb2, occ);
+                                            line += ws * (l1 - l0) * k;
+                                        }
+                                    });
                                     total.add(wz * wp * wq * jac * span * line);
                                 }
                             }
