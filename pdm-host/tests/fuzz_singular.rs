@@ -499,12 +499,16 @@ fn check_edge_case(case: &EdgeCase, stats: &mut Stats) -> Result<(), TestCaseErr
         // of 9e-5, 1.8e-11 at 1° (unit squares at 1°: 9.3e-12 off at order 12).
         // Plus the rounding of the coordinates (cells ≈ 7e4 cell sizes from the origin: 1.4e-12
         // at 73°, seed 7).
+        // Neighbouring cells with a gap at a small fold are a near vertex whose edges diverge
+        // at θ: the vertex transform converges algebraically there and each direction grades
+        // its own way (finding 19: 4.3e-9 at order 12, 1.2e-9 at 16, 2.5e-11 at 32 for 3.3°).
         let rounding = 8.0 * f64::EPSILON * magnitude / diag;
         let allowed = rounding
             + match k {
                 0 if case.theta_deg < 10.0 => 1e-10,
                 0 if case.gap > 0.0 => 1e-11,
                 0 => 1e-12,
+                _ if case.theta_deg < 10.0 && case.gap > 0.0 => 1e-8,
                 _ => 1e-13,
             };
         prop_assert!(r <= allowed, "reciprocity, cell offset {k}: {ab:e} vs {ba:e}");
