@@ -25,9 +25,10 @@
 //! more gaps, aspects and grids). Print the per-class summary with `--nocapture`.
 //! The README's test command runs the fast classes (contour, direct, strips, nearly coincident);
 //! the others are `slow_*` tests that `.ci/run` runs with `-- --ignored slow_`.
-//! CI-mode runtime (release, this 2-core machine shared with another job): about 190 s for
-//! the nine class tests and the plain-rule test together; the slowest classes are
-//! closed-curved and closed-sphere (kernel time, not rays).
+//! CI-mode runtime (release, this 2-core machine, nothing else running): 1.6 s for the fast
+//! classes and 116 s for the six `slow_*` tests on two test threads; the longest single case is
+//! the cylinder patch over the floor (52 s: kernel time, not rays). On a loaded machine the
+//! slow tests have taken up to 206 s.
 //! Building the test binary comes on top (1.5–7 min here, depending on the load).
 
 // Test code: panicking on failure and indexing fixed test data is intended.
@@ -504,6 +505,10 @@ fn run_precision<T: Real>(c: &Case, r: &Ref, out: &mut Outcome, label: &str) {
     // integral (shadow edges meeting the inner patch's corners and edges are kinks of the
     // outer integrand): its documented accuracy at `PairSettings::ACCURATE` is 1e-4 there.
     let pair_tol = if c.occ.is_empty() { pair_tol } else { pair_tol.max(1e-4) };
+    // Against a Monte Carlo reference (4σ ≈ 1e-3 relative at the CI mode's 4e5 rays) an estimate
+    // can only be checked at the reference's resolution: the CI mode asks the tolerance mode for
+    // 1e-4 there; the long mode keeps 1e-6 for the argument-order check between its two values.
+    let adaptive_tol = if r.mc && !long_mode() { adaptive_tol.max(1e-4) } else { adaptive_tol };
     let t0 = Instant::now();
     let mut fails: Vec<String> = Vec::new();
     let mut fail = |msg: String| fails.push(format!("{} [{label}]: {msg}", c.name));
