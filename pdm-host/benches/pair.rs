@@ -11,6 +11,14 @@
 //! - `c41`: coaxial unit disks 0.01 apart, whole (C-41; cut into 4 × 4 piece pairs, the contour
 //!   form along the curved edges).
 //!
+//! - `half-wall-0.1`: half a cylinder wall (radius 0.5, height 1) standing 0.1 above a 4 × 4
+//!   floor: curved against flat, straddling the back-face cut and near; the inner integral over
+//!   the floor from each wall point by the point-to-polygon form (no closed form: the error
+//!   printed is the difference from order 24);
+//! - `disk-wall-0.1`: a whole unit disk 0.1 below a whole cylinder wall of radius 1 and height
+//!   1 (the C-41 algebra, F(disk → disk at 0.1) − F(disk → disk at 1.1)); the inner integral over
+//!   the disk by the point form along its outline.
+//!
 //! The relative errors are printed once per case before timing. Single-threaded.
 
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
@@ -64,6 +72,40 @@ fn bench_pairs(c: &mut Criterion) {
         });
         group.bench_with_input(BenchmarkId::new("c41-0.01/contour", order), &order, |bench, _| {
             bench.iter(|| pair_exchange::<f64, _, _, _, 256>(black_box(&pl), black_box(&pu), s, &()).unwrap());
+        });
+    }
+    group.finish();
+    near_flat(c);
+}
+
+fn near_flat(c: &mut Criterion) {
+    use pdm_kernel::{Cylinder, ParamRect, Side};
+    let up = vec3(0.0, 0.0, 1.0);
+    let half_wall = Cylinder::new(vec3(0.0, 0.0, 0.1), up, 0.5, 1.0, Side::Outer).unwrap();
+    let big_floor = Parallelogram::new(vec3(-2.0, -2.0, 0.0), vec3(4.0, 0.0, 0.0), vec3(0.0, 4.0, 0.0)).unwrap();
+    let ph = Patch::new(&half_wall, ParamRect { t0: 0.0, t1: std::f64::consts::PI, s0: 0.0, s1: 1.0 }).unwrap();
+    let pb = Patch::whole(&big_floor).unwrap();
+    let disk = Disk::new(vec3(0.0, 0.0, 0.0), up, 1.0).unwrap();
+    let wall = Cylinder::new(vec3(0.0, 0.0, 0.1), up, 1.0, 1.0, Side::Inner).unwrap();
+    let (pd, pw) = (Patch::whole(&disk).unwrap(), Patch::whole(&wall).unwrap());
+    let disk_wall = std::f64::consts::PI * (coaxial_disks(1.0, 1.0, 0.1) - coaxial_disks(1.0, 1.0, 1.1));
+    let wall_24 = pair_exchange::<f64, _, _, _, 625>(&ph, &pb, settings(24), &()).unwrap();
+    let mut group = c.benchmark_group("pair");
+    group.sample_size(10);
+    for order in [12, 16] {
+        let s = PairSettings { order, singular_order: 12, boundaries: true };
+        let w = pair_exchange::<f64, _, _, _, 256>(&ph, &pb, s, &()).unwrap();
+        let d = pair_exchange::<f64, _, _, _, 256>(&pd, &pw, s, &()).unwrap();
+        eprintln!(
+            "order {order}: half wall 0.1 above a floor {:.1e} (against order 24), disk 0.1 below a wall {:.1e}",
+            (w - wall_24).abs() / wall_24,
+            (d - disk_wall).abs() / disk_wall
+        );
+        group.bench_with_input(BenchmarkId::new("half-wall-0.1", order), &order, |bench, _| {
+            bench.iter(|| pair_exchange::<f64, _, _, _, 256>(black_box(&ph), black_box(&pb), s, &()).unwrap());
+        });
+        group.bench_with_input(BenchmarkId::new("disk-wall-0.1", order), &order, |bench, _| {
+            bench.iter(|| pair_exchange::<f64, _, _, _, 256>(black_box(&pd), black_box(&pw), s, &()).unwrap());
         });
     }
     group.finish();

@@ -1278,7 +1278,6 @@ fn mark_known(v: Vec<Case>) -> Vec<Case> {
         "sphere 4x8 -> disk 2x4 below",
         "sphere 4x8 -> disk 1x4 below",
         "whole sphere r=0.5 at 1 -> whole disk r=1 below",
-        "whole outer cylinder -> floor below (periodic)",
         "paper: sphere 4x8 -> cube floor 2x2 (self-occluding)",
         "sphere 1e-8 above a plate 4x4, self-occluding",
         "squares, sphere + cylinder + disk between",
@@ -1400,7 +1399,6 @@ single_case! {
     long_sphere_grid_to_disk_grid: "long: over 4 min" => "sphere 4x8 -> disk 2x4 below";
     long_sphere_grid_to_disk: "long: 3.4 min" => "sphere 4x8 -> disk 1x4 below";
     long_whole_sphere_to_disk: "long: 82 s" => "whole sphere r=0.5 at 1 -> whole disk r=1 below";
-    long_whole_cylinder_to_floor: "long: 23 s" => "whole outer cylinder -> floor below (periodic)";
     long_paper_sphere_to_floor: "long: over 3 min" => "paper: sphere 4x8 -> cube floor 2x2 (self-occluding)";
     long_sphere_1e_8_above_plate: "long: pair_exchange 106 s, over 6 min in all" => "sphere 1e-8 above a plate 4x4, self-occluding";
     long_squares_three_occluders: "long: 46 s" => "squares, sphere + cylinder + disk between";

@@ -169,7 +169,9 @@ where
         rule: GaussRule::<T>::new(order)?,
         probes: 2 * order + 3,
         affine: if closed_form { affine } else { None },
-        outline: if cfg!(feature = "closed-form") && affine.is_none() { crate::contour::Outline::new(b) } else { None },
+        #[cfg(feature = "closed-form")]
+        outline: if affine.is_none() { crate::contour::Outline::new(b) } else { None },
+        #[cfg(feature = "closed-form")]
         line_rule: GaussRule::<T>::new(order.max(16))?,
         use_occluders,
         occluders,
@@ -521,9 +523,11 @@ struct Inner<'x, T: Real, SB: Surface<T> + ?Sized, O: ?Sized> {
     affine: Option<(Vec3<T>, Vec3<T>, Vec3<T>)>,
     /// b's outline when b is flat but not a parallelogram (a disk or annulus sector, a planar
     /// Bézier patch): the point-to-region form along it.
+    #[cfg(feature = "closed-form")]
     outline: Option<crate::contour::Outline<'x, T, SB>>,
     /// The rule along the outline's edges: at least order 16, whose few hundred evaluations per
     /// outer point make J(p) exact to rounding at any outer order.
+    #[cfg(feature = "closed-form")]
     line_rule: GaussRule<T>,
     use_occluders: bool,
     occluders: &'x O,
@@ -795,10 +799,7 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
     /// cancel by more than [`POLYGON_CANCELLATION`], and the caller integrates by the rule.
     fn point_to_polygon(&self, p: Vec3<T>, np: Vec3<T>) -> Option<T> {
         let Some((o, et, es)) = self.affine else {
-            // A flat b with curved edges: the same form along its outline.
-            let (j, magnitude, n) = self.outline.as_ref()?.point_form(&self.line_rule, p, np)?;
-            self.count.set(self.count.get().saturating_add(n));
-            return (magnitude <= T::from_f64(POLYGON_CANCELLATION) * j).then_some(j);
+            return self.point_to_outline(p, np);
         };
         let r = self.r;
         let nq = self.surface.normal(r.t0, r.s0);
@@ -846,6 +847,21 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
         }
         let j = sum.abs() * T::HALF;
         (j.is_finite() && magnitude <= T::from_f64(POLYGON_CANCELLATION) * sum.abs()).then_some(j)
+    }
+
+    /// [`Self::point_to_polygon`] on a flat b with curved edges, along its outline
+    /// (`contour::Outline::point_form`); `None` where b has no outline.
+    #[cfg(feature = "closed-form")]
+    fn point_to_outline(&self, p: Vec3<T>, np: Vec3<T>) -> Option<T> {
+        let (j, magnitude, n) = self.outline.as_ref()?.point_form(&self.line_rule, p, np)?;
+        self.count.set(self.count.get().saturating_add(n));
+        (magnitude <= T::from_f64(POLYGON_CANCELLATION) * j).then_some(j)
+    }
+
+    /// Without closed forms there is no outline form.
+    #[cfg(not(feature = "closed-form"))]
+    fn point_to_outline(&self, _p: Vec3<T>, _np: Vec3<T>) -> Option<T> {
+        None
     }
 
     /// `true` if p lies closer to the ball than its radius: a rule over the ball's patch then
