@@ -25,10 +25,10 @@
 //! more gaps, aspects and grids). Print the per-class summary with `--nocapture`.
 //! The README's test command runs the fast classes (contour, direct, strips, nearly coincident);
 //! the others are `slow_*` tests that `.ci/run` runs with `-- --ignored slow_`.
-//! CI-mode runtime (release, this 2-core machine, nothing else running): 1.6 s for the fast
-//! classes and 116 s for the six `slow_*` tests on two test threads; the longest single case is
-//! the cylinder patch over the floor (52 s: kernel time, not rays). On a loaded machine the
-//! slow tests have taken up to 206 s.
+//! CI-mode runtime (release, this 2-core machine): 1.6 s for the fast classes and 80 s for the
+//! six `slow_*` tests on two test threads with one other build running; the longest cases are
+//! the inner sphere's self pairs and the disks closing walls across small gaps (about 30 s
+//! each; kernel time, not rays). Under a load of 4 the slow tests took 148 s.
 //! Building the test binary comes on top (1.5–7 min here, depending on the load).
 
 // Test code: panicking on failure and indexing fixed test data is intended.
