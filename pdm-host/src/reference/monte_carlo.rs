@@ -14,7 +14,7 @@
 //! Random numbers: xoshiro256** ([`rand_xoshiro::Xoshiro256StarStar`], seeded through its
 //! SplitMix64), uniform doubles with 53 random bits (`rand`'s `StandardUniform`). The rays are
 //! split into fixed chunks, each with its own stream derived from `(seed, chunk index)`, and the
-//! chunks are distributed over `std::thread::scope` threads; the integer counts are summed, so
+//! chunks run on rayon's pool (as in [`super::raytrace`]); the integer counts are summed, so
 //! the result depends on the seed and the ray count only, not on the number of threads.
 //!
 //! Values obtained for `l = 6`, `R = 1` with 10⁹ rays from face 1 (seed 2024, release build, 2
@@ -26,6 +26,7 @@
 
 use rand::{Rng, RngExt, SeedableRng};
 use rand_xoshiro::{SplitMix64, Xoshiro256StarStar};
+use rayon::prelude::*;
 use std::f64::consts::PI;
 
 /// A Monte Carlo estimate.
@@ -199,45 +200,26 @@ fn chunk_rng(seed: u64, chunk: u64) -> Xoshiro256StarStar {
     Xoshiro256StarStar::seed_from_u64(sm.next_u64())
 }
 
-/// Runs `rays` rays split into chunks with independent streams over the available cores.
+/// Chunks of a run: each has its own stream, so a result depends only on the seed and the ray
+/// count.
+const CHUNKS: u64 = 256;
+
+/// Runs `rays` rays split into [`CHUNKS`] chunks with independent streams on rayon's pool and
+/// sums their hit counters.
 fn run_parallel<F>(rays: u64, seed: u64, work: F) -> Counts
 where
     F: Fn(&mut Xoshiro256StarStar, u64) -> Counts + Sync,
 {
-    let chunks: u64 = 256;
-    let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).clamp(1, 64);
-    let per = rays / chunks;
-    let extra = rays % chunks;
-    let work = &work;
-    let mut total = [0u64; 7];
-    std::thread::scope(|scope| {
-        let handles: Vec<_> = (0..threads as u64)
-            .map(|tid| {
-                scope.spawn(move || {
-                    let mut acc = [0u64; 7];
-                    let mut chunk = tid;
-                    while chunk < chunks {
-                        let n = per + u64::from(chunk < extra);
-                        let mut rng = chunk_rng(seed, chunk);
-                        let c = work(&mut rng, n);
-                        for (a, b) in acc.iter_mut().zip(c.iter()) {
-                            *a += b;
-                        }
-                        chunk += threads as u64;
-                    }
-                    acc
-                })
-            })
-            .collect();
-        for hnd in handles {
-            if let Ok(c) = hnd.join() {
-                for (a, b) in total.iter_mut().zip(c.iter()) {
-                    *a += b;
-                }
+    let (per, extra) = (rays / CHUNKS, rays % CHUNKS);
+    (0..CHUNKS).into_par_iter().map(|chunk| work(&mut chunk_rng(seed, chunk), per + u64::from(chunk < extra))).reduce(
+        || [0u64; 7],
+        |mut a, b| {
+            for (x, y) in a.iter_mut().zip(b) {
+                *x += y;
             }
-        }
-    });
-    total
+            a
+        },
+    )
 }
 
 fn estimate(hits: u64, rays: u64, share: f64) -> McEstimate {
