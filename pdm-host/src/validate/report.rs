@@ -3,6 +3,7 @@
 
 use std::fmt::Write as _;
 
+use serde::Serialize;
 use serde_json::{json, Map, Value};
 
 use super::paper::{paper_duration, PaperValues};
@@ -45,6 +46,51 @@ fn pair_object(values: &[f64; 15]) -> Value {
         m.insert(pair_key(a, b), json!(v));
     }
     Value::Object(m)
+}
+
+/// Columns of the `--format csv` output.
+pub const CSV_COLUMNS: [&str; 8] =
+    ["table", "item", "precision", "paper", "ours", "reference", "relative_error", "reference_uncertainty"];
+
+/// The `ours` column: a value, or a setting's text.
+#[derive(Serialize)]
+#[serde(untagged)]
+enum CsvCell {
+    Number(#[serde(with = "crate::csv_num")] f64),
+    Text(String),
+}
+
+/// One record of the `--format csv` output ([`CSV_COLUMNS`]); NaN is an empty field.
+#[derive(Serialize)]
+struct CsvRow {
+    table: &'static str,
+    item: String,
+    precision: &'static str,
+    #[serde(with = "crate::csv_num")]
+    paper: f64,
+    ours: CsvCell,
+    #[serde(with = "crate::csv_num")]
+    reference: f64,
+    #[serde(with = "crate::csv_num")]
+    relative_error: f64,
+    #[serde(with = "crate::csv_num")]
+    reference_uncertainty: f64,
+}
+
+impl CsvRow {
+    /// A row with text in `ours` and no reference.
+    fn text(table: &'static str, item: String, precision: &'static str, paper: Option<f64>, ours: &str) -> Self {
+        Self {
+            table,
+            item,
+            precision,
+            paper: paper.unwrap_or(f64::NAN),
+            ours: CsvCell::Text(ours.into()),
+            reference: f64::NAN,
+            relative_error: f64::NAN,
+            reference_uncertainty: f64::NAN,
+        }
+    }
 }
 
 impl Report {
@@ -169,38 +215,50 @@ impl Report {
         Value::Object(top)
     }
 
-    /// CSV (`--format csv`): one row per value and precision, then timing and setting rows.
+    /// CSV (`--format csv`): one row per value and precision, then timing and setting rows
+    /// ([`CSV_COLUMNS`]).
     #[must_use]
     pub fn to_csv(&self) -> String {
-        let mut out = String::from("table,item,precision,paper,ours,reference,relative_error,reference_uncertainty\n");
-        let num = |x: Option<f64>| x.map_or(String::new(), |x| format!("{x:e}"));
+        let mut w = csv::WriterBuilder::new().has_headers(false).from_writer(Vec::new());
+        // Writing to memory fails only on a serialization error, which these plain fields cannot raise.
+        let _ = w.write_record(CSV_COLUMNS);
+        for row in self.csv_rows() {
+            let _ = w.serialize(row);
+        }
+        w.into_inner().map(|b| String::from_utf8_lossy(&b).into_owned()).unwrap_or_default()
+    }
+
+    fn csv_rows(&self) -> Vec<CsvRow> {
+        let mut rows = Vec::new();
         let r = &self.reference;
+        let value = |table: &'static str,
+                     item: String,
+                     precision: &'static str,
+                     paper: Option<f64>,
+                     ours: f64,
+                     re: f64,
+                     unc: f64| CsvRow {
+            table,
+            item,
+            precision,
+            paper: paper.unwrap_or(f64::NAN),
+            ours: CsvCell::Number(ours),
+            reference: re,
+            relative_error: relative_error(ours, re),
+            reference_uncertainty: unc,
+        };
         for o in &self.outcomes {
             let p = o.precision.name();
             let v = &o.values;
-            let mut row = |table: &str, item: String, paper: Option<f64>, ours: f64, re: f64, unc: f64| {
-                let _ = writeln!(
-                    out,
-                    "{table},{item},{p},{},{ours:e},{re:e},{:e},{unc:e}",
-                    num(paper),
-                    relative_error(ours, re)
-                );
-            };
             if let (Some(s), Some(rs)) = (v.sphere_to_face, r.sphere_to_face) {
                 for (f, (&x, &y)) in s.iter().zip(&rs).enumerate() {
-                    row(
-                        "sphere_to_face",
-                        (f + 1).to_string(),
-                        self.paper.map(|pv| pv.sphere_to_face(f + 1)),
-                        x,
-                        y,
-                        0.0,
-                    );
+                    let paper = self.paper.map(|pv| pv.sphere_to_face(f + 1));
+                    rows.push(value("sphere_to_face", (f + 1).to_string(), p, paper, x, y, 0.0));
                 }
             }
             if let (Some(s), Some(rs)) = (v.face_to_sphere, r.face_to_sphere) {
                 for (f, (&x, &y)) in s.iter().zip(&rs).enumerate() {
-                    row("face_to_sphere", (f + 1).to_string(), None, x, y, 0.0);
+                    rows.push(value("face_to_sphere", (f + 1).to_string(), p, None, x, y, 0.0));
                 }
             }
             for (k, &(a, b)) in FACE_PAIRS.iter().enumerate() {
@@ -209,10 +267,19 @@ impl Report {
                     r.face_to_face.get(k).copied().unwrap_or(f64::NAN),
                     r.face_to_face_uncertainty.get(k).copied().unwrap_or(f64::NAN),
                 );
-                row("face_to_face", pair_key(a, b), self.paper.map(|pv| pv.face_to_face(a, b)), x, y, u);
+                rows.push(value(
+                    "face_to_face",
+                    pair_key(a, b),
+                    p,
+                    self.paper.map(|pv| pv.face_to_face(a, b)),
+                    x,
+                    y,
+                    u,
+                ));
             }
             for (f, (&x, &y)) in v.face_sum.iter().zip(&r.face_sum).enumerate() {
-                row("face_sum", (f + 1).to_string(), self.paper.and_then(|pv| pv.face_sum(f + 1)), x, y, 0.0);
+                let paper = self.paper.and_then(|pv| pv.face_sum(f + 1));
+                rows.push(value("face_sum", (f + 1).to_string(), p, paper, x, y, 0.0));
             }
             let secs = [
                 ("sphere_face", self.paper.map(|pv| pv.sphere_face_seconds), o.sphere_face_seconds()),
@@ -220,7 +287,7 @@ impl Report {
                 ("total", self.paper.map(|pv| pv.sphere_face_seconds + pv.face_face_seconds), o.total_seconds()),
             ];
             for (item, paper, ours) in secs {
-                let _ = writeln!(out, "seconds,{item},{p},{},{ours:e},,,", num(paper));
+                rows.push(CsvRow { ours: CsvCell::Number(ours), ..CsvRow::text("seconds", item.into(), p, paper, "") });
             }
         }
         if let Some(first) = self.outcomes.first() {
@@ -233,12 +300,12 @@ impl Report {
                     Value::Null => String::new(),
                     other => other.to_string().replace(',', "x").replace(['[', ']'], ""),
                 };
-                let _ = writeln!(out, "setting,{k},,,{text},,,");
+                rows.push(CsvRow::text("setting", k, "", None, &text));
             }
             let precisions: Vec<&str> = self.outcomes.iter().map(|o| o.precision.name()).collect();
-            let _ = writeln!(out, "setting,precision,,,{},,,", precisions.join(" "));
+            rows.push(CsvRow::text("setting", "precision".into(), "", None, &precisions.join(" ")));
         }
-        out
+        rows
     }
 
     /// The human-readable tables (≤ 80 columns).
