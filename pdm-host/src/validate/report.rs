@@ -1,11 +1,13 @@
 //! Rendering a `validate` run: an 80-column table shaped like the paper's tables with our
 //! columns added, the JSON contract, or CSV.
 
+use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
 use serde::Serialize;
-use serde_json::{json, Map, Value};
+use serde_json::{Map, Value};
 
+use super::compute::Times;
 use super::paper::{paper_duration, PaperValues};
 use super::reference::{Reference, Source};
 use super::scene::{pair_key, FACE_PAIRS};
@@ -40,12 +42,92 @@ fn rel_errors(ours: &[f64], reference: &[f64]) -> Vec<f64> {
     ours.iter().zip(reference).map(|(&o, &r)| relative_error(o, r)).collect()
 }
 
-fn pair_object(values: &[f64; 15]) -> Value {
-    let mut m = Map::new();
-    for (&(a, b), &v) in FACE_PAIRS.iter().zip(values) {
-        m.insert(pair_key(a, b), json!(v));
-    }
-    Value::Object(m)
+/// Values per face pair, keyed "1-2" … "5-6".
+type PairMap = BTreeMap<String, f64>;
+
+fn pair_object(values: &[f64; 15]) -> PairMap {
+    FACE_PAIRS.iter().zip(values).map(|(&(a, b), &v)| (pair_key(a, b), v)).collect()
+}
+
+/// The settings of a run (part of the JSON document; also the CSV's setting rows).
+#[derive(Serialize)]
+struct SettingsJson {
+    command: &'static str,
+    mode: &'static str,
+    precision: &'static str,
+    patches: usize,
+    patches_option: Option<usize>,
+    sphere_grid: Option<[usize; 2]>,
+    face_grid: usize,
+    order: usize,
+    singular_order: Option<usize>,
+    tolerance: Option<f64>,
+    sphere_radius: f64,
+    repeat: usize,
+    threads: usize,
+}
+
+#[derive(Serialize)]
+struct ReferenceJson<'a> {
+    sphere_to_face: &'a Option<[f64; 6]>,
+    face_to_sphere: &'a Option<[f64; 6]>,
+    face_to_face: PairMap,
+    face_sum: &'a [f64; 6],
+    face_to_face_uncertainty: PairMap,
+    source: String,
+    sum_rule_residual: f64,
+    seconds: f64,
+}
+
+#[derive(Serialize)]
+struct PaperSecondsJson {
+    sphere_face: f64,
+    face_face: f64,
+}
+
+#[derive(Serialize)]
+struct PaperJson {
+    patches: usize,
+    sphere_to_face: Vec<f64>,
+    face_to_face: PairMap,
+    face_sum: Vec<Option<f64>>,
+    seconds: PaperSecondsJson,
+}
+
+#[derive(Serialize)]
+struct RelativeErrorJson {
+    sphere_to_face: Option<Vec<f64>>,
+    face_to_sphere: Option<Vec<f64>>,
+    face_to_face: PairMap,
+    face_sum: Vec<f64>,
+}
+
+#[derive(Serialize)]
+struct TimingJson<'a> {
+    sphere_face: f64,
+    face_face: f64,
+    runs: &'a [Times],
+    reference: f64,
+}
+
+/// One precision's document; a second precision is nested under its name ("f32").
+#[derive(Serialize)]
+struct OutcomeJson<'a> {
+    #[serde(flatten)]
+    settings: SettingsJson,
+    sphere_to_face: &'a Option<[f64; 6]>,
+    face_to_sphere: &'a Option<[f64; 6]>,
+    face_to_face: PairMap,
+    face_sum: &'a [f64; 6],
+    estimated_error: Option<f64>,
+    unconverged_pairs: Option<u64>,
+    reference: ReferenceJson<'a>,
+    relative_error: RelativeErrorJson,
+    paper: Option<PaperJson>,
+    seconds: f64,
+    timing: TimingJson<'a>,
+    #[serde(flatten)]
+    other_precisions: BTreeMap<&'static str, OutcomeJson<'a>>,
 }
 
 /// Columns of the `--format csv` output.
@@ -94,114 +176,99 @@ impl CsvRow {
 }
 
 impl Report {
-    fn settings_json(&self, o: &Outcome) -> Map<String, Value> {
+    fn settings_json(&self, o: &Outcome) -> SettingsJson {
         let c = &self.config;
-        let mut m = Map::new();
-        m.insert("command".into(), json!("validate"));
-        m.insert("mode".into(), json!(c.mode.name()));
-        m.insert("precision".into(), json!(o.precision.name()));
-        m.insert("patches".into(), json!(c.total_patches()));
-        m.insert("patches_option".into(), json!(self.patches));
-        m.insert(
-            "sphere_grid".into(),
-            if c.radius > 0.0 { json!([c.sphere_grid.0, c.sphere_grid.1]) } else { Value::Null },
-        );
-        m.insert("face_grid".into(), json!(c.face_grid));
-        m.insert("order".into(), json!(c.order));
-        m.insert("singular_order".into(), if c.mode == Mode::Accurate { json!(c.singular_order) } else { Value::Null });
-        m.insert("tolerance".into(), c.tolerance.map_or(Value::Null, |t| json!(t)));
-        m.insert("sphere_radius".into(), json!(c.radius));
-        m.insert("repeat".into(), json!(self.repeat));
-        m.insert("threads".into(), json!(self.threads));
-        m
+        SettingsJson {
+            command: "validate",
+            mode: c.mode.name(),
+            precision: o.precision.name(),
+            patches: c.total_patches(),
+            patches_option: self.patches,
+            sphere_grid: (c.radius > 0.0).then_some([c.sphere_grid.0, c.sphere_grid.1]),
+            face_grid: c.face_grid,
+            order: c.order,
+            singular_order: (c.mode == Mode::Accurate).then_some(c.singular_order),
+            tolerance: c.tolerance,
+            sphere_radius: c.radius,
+            repeat: self.repeat,
+            threads: self.threads,
+        }
     }
 
-    fn reference_json(&self) -> Value {
+    fn reference_json(&self) -> ReferenceJson<'_> {
         let r = &self.reference;
-        let mut unc = Map::new();
-        for (&(a, b), &u) in FACE_PAIRS.iter().zip(&r.face_to_face_uncertainty) {
-            unc.insert(pair_key(a, b), json!(u));
-        }
-        json!({
-            "sphere_to_face": r.sphere_to_face,
-            "face_to_sphere": r.face_to_sphere,
-            "face_to_face": pair_object(&r.face_to_face),
-            "face_sum": r.face_sum,
-            "face_to_face_uncertainty": Value::Object(unc),
-            "source": match &r.source {
+        ReferenceJson {
+            sphere_to_face: &r.sphere_to_face,
+            face_to_sphere: &r.face_to_sphere,
+            face_to_face: pair_object(&r.face_to_face),
+            face_sum: &r.face_sum,
+            face_to_face_uncertainty: pair_object(&r.face_to_face_uncertainty),
+            source: match &r.source {
                 Source::ClosedForm => "closed_form (C-11, C-14)".to_string(),
                 Source::Independent => "pdm_host::reference::cube".to_string(),
                 Source::Stored => "pdm_host::reference::cube (stored for R = 1)".to_string(),
                 Source::Unavailable(why) => format!("unavailable: {why}"),
             },
-            "sum_rule_residual": r.sum_rule_residual(),
-            "seconds": r.seconds,
-        })
+            sum_rule_residual: r.sum_rule_residual(),
+            seconds: r.seconds,
+        }
     }
 
-    fn paper_json(&self) -> Value {
-        let Some(p) = self.paper else {
-            return Value::Null;
-        };
-        let s2f: Vec<f64> = (1..=6).map(|f| p.sphere_to_face(f)).collect();
+    fn paper_json(&self) -> Option<PaperJson> {
+        let p = self.paper?;
         let mut ff = [0.0; 15];
         for (&(a, b), v) in FACE_PAIRS.iter().zip(&mut ff) {
             *v = p.face_to_face(a, b);
         }
-        let sums: Vec<Option<f64>> = (1..=6).map(|f| p.face_sum(f)).collect();
-        json!({
-            "patches": p.patches,
-            "sphere_to_face": s2f,
-            "face_to_face": pair_object(&ff),
-            "face_sum": sums,
-            "seconds": {"sphere_face": p.sphere_face_seconds, "face_face": p.face_face_seconds},
+        Some(PaperJson {
+            patches: p.patches,
+            sphere_to_face: (1..=6).map(|f| p.sphere_to_face(f)).collect(),
+            face_to_face: pair_object(&ff),
+            face_sum: (1..=6).map(|f| p.face_sum(f)).collect(),
+            seconds: PaperSecondsJson { sphere_face: p.sphere_face_seconds, face_face: p.face_face_seconds },
         })
     }
 
-    fn outcome_json(&self, o: &Outcome) -> Map<String, Value> {
+    fn outcome_json<'a>(&'a self, o: &'a Outcome) -> OutcomeJson<'a> {
         let v = &o.values;
         let r = &self.reference;
-        let mut m = self.settings_json(o);
-        m.insert("sphere_to_face".into(), json!(v.sphere_to_face));
-        m.insert("face_to_sphere".into(), json!(v.face_to_sphere));
-        m.insert("face_to_face".into(), pair_object(&v.face_to_face));
-        m.insert("face_sum".into(), json!(v.face_sum));
-        m.insert("estimated_error".into(), json!(v.estimated_error));
-        m.insert("unconverged_pairs".into(), json!(v.unconverged_pairs));
-        m.insert("reference".into(), self.reference_json());
         let mut ff_err = [0.0; 15];
         for ((e, &ours), &re) in ff_err.iter_mut().zip(&v.face_to_face).zip(&r.face_to_face) {
             *e = relative_error(ours, re);
         }
         let pair_err = |ours: &Option<[f64; 6]>, re: &Option<[f64; 6]>| match (ours, re) {
-            (Some(a), Some(b)) => json!(rel_errors(a, b)),
-            _ => Value::Null,
+            (Some(a), Some(b)) => Some(rel_errors(a, b)),
+            _ => None,
         };
-        m.insert(
-            "relative_error".into(),
-            json!({
-                "sphere_to_face": pair_err(&v.sphere_to_face, &r.sphere_to_face),
-                "face_to_sphere": pair_err(&v.face_to_sphere, &r.face_to_sphere),
-                "face_to_face": pair_object(&ff_err),
-                "face_sum": rel_errors(&v.face_sum, &r.face_sum),
-            }),
-        );
-        m.insert("paper".into(), self.paper_json());
-        m.insert("seconds".into(), json!(o.total_seconds()));
-        m.insert(
-            "timing".into(),
-            json!({
-                "sphere_face": o.sphere_face_seconds(),
-                "face_face": o.face_face_seconds(),
-                "runs": o.times.iter().map(|t| json!({"sphere_face": t.sphere_face, "face_face": t.face_face})).collect::<Vec<_>>(),
-                "reference": r.seconds,
-            }),
-        );
-        m
+        OutcomeJson {
+            settings: self.settings_json(o),
+            sphere_to_face: &v.sphere_to_face,
+            face_to_sphere: &v.face_to_sphere,
+            face_to_face: pair_object(&v.face_to_face),
+            face_sum: &v.face_sum,
+            estimated_error: v.estimated_error,
+            unconverged_pairs: v.unconverged_pairs,
+            reference: self.reference_json(),
+            relative_error: RelativeErrorJson {
+                sphere_to_face: pair_err(&v.sphere_to_face, &r.sphere_to_face),
+                face_to_sphere: pair_err(&v.face_to_sphere, &r.face_to_sphere),
+                face_to_face: pair_object(&ff_err),
+                face_sum: rel_errors(&v.face_sum, &r.face_sum),
+            },
+            paper: self.paper_json(),
+            seconds: o.total_seconds(),
+            timing: TimingJson {
+                sphere_face: o.sphere_face_seconds(),
+                face_face: o.face_face_seconds(),
+                runs: &o.times,
+                reference: r.seconds,
+            },
+            other_precisions: BTreeMap::new(),
+        }
     }
 
     /// The JSON document (`--format json`): the first outcome's object; with two precisions the
-    /// f32 outcome is nested under the key "f32".
+    /// f32 outcome is nested under the key "f32". Keys are sorted.
     #[must_use]
     pub fn to_json(&self) -> Value {
         let mut iter = self.outcomes.iter();
@@ -209,10 +276,8 @@ impl Report {
             return Value::Null;
         };
         let mut top = self.outcome_json(first);
-        for o in iter {
-            top.insert(o.precision.name().into(), Value::Object(self.outcome_json(o)));
-        }
-        Value::Object(top)
+        top.other_precisions = iter.map(|o| (o.precision.name(), self.outcome_json(o))).collect();
+        serde_json::to_value(top).unwrap_or(Value::Null)
     }
 
     /// CSV (`--format csv`): one row per value and precision, then timing and setting rows
@@ -291,7 +356,11 @@ impl Report {
             }
         }
         if let Some(first) = self.outcomes.first() {
-            for (k, val) in self.settings_json(first) {
+            let settings = match serde_json::to_value(self.settings_json(first)) {
+                Ok(Value::Object(m)) => m,
+                _ => Map::new(),
+            };
+            for (k, val) in settings {
                 if k == "precision" {
                     continue;
                 }
