@@ -4,6 +4,7 @@
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
+use comfy_table::{presets, CellAlignment, ColumnConstraint, ContentArrangement, Table, Width};
 use serde::Serialize;
 use serde_json::{Map, Value};
 
@@ -407,56 +408,64 @@ impl Report {
             Some(p) => format!("paper {}", p.patches),
             None => "paper".into(),
         };
-        // Header: item, paper, [paper err], reference, per outcome: ours, rel.err
-        let header = |out: &mut String, item: &str| {
-            let _ = write!(out, "{item:>5} {paper_name:>10}");
+        // Columns: item, paper, [paper err], reference, per outcome: ours, rel.err (minimum widths).
+        let mut widths: Vec<(u16, CellAlignment)> = vec![(5, CellAlignment::Right), (10, CellAlignment::Right)];
+        if !two {
+            widths.push((8, CellAlignment::Right));
+        }
+        widths.push((15, CellAlignment::Right));
+        for o in &self.outcomes {
+            widths.push((if o.precision.name() == "f32" && two { 13 } else { 15 }, CellAlignment::Right));
+            widths.push((7, CellAlignment::Right));
+        }
+        let header = |item: &str| {
+            let mut row = vec![item.to_string(), paper_name.clone()];
             if !two {
-                let _ = write!(out, " {:>8}", "p.err");
+                row.push("p.err".into());
             }
-            let _ = write!(out, " {:>15}", "reference");
+            row.push("reference".into());
             for o in &self.outcomes {
-                let w = if o.precision.name() == "f32" && two { 13 } else { 15 };
-                let _ = write!(out, " {:>w$} {:>7}", format!("ours {}", o.precision.name()), "rel.err");
+                row.push(format!("ours {}", o.precision.name()));
+                row.push("rel.err".into());
             }
-            out.push('\n');
+            vec![row]
         };
         let fmt_ours = |x: f64, f32_col: bool, fixed: bool| match (fixed, f32_col && two) {
-            (true, true) => format!("{x:>13.8}"),
-            (true, false) => format!("{x:>15.10}"),
-            (false, true) => format!("{x:>13.7e}"),
-            (false, false) => format!("{x:>15.9e}"),
+            (true, true) => format!("{x:.8}"),
+            (true, false) => format!("{x:.10}"),
+            (false, true) => format!("{x:.7e}"),
+            (false, false) => format!("{x:.9e}"),
         };
-        let line = |out: &mut String, item: String, paper: Option<f64>, re: f64, ours: Vec<f64>, fixed: bool| {
+        let line = |item: String, paper: Option<f64>, re: f64, ours: Vec<f64>, fixed: bool| {
             let p = match paper {
                 Some(p) if fixed => format!("{p:.4}"),
                 Some(p) => format!("{p:.4e}"),
                 None => "-".into(),
             };
-            let _ = write!(out, "{item:>5} {p:>10}");
+            let mut row = vec![item, p];
             if !two {
-                let pe = paper.map_or("-".into(), |p| fmt_err(relative_error(p, re)));
-                let _ = write!(out, " {pe:>8}");
+                row.push(paper.map_or("-".into(), |p| fmt_err(relative_error(p, re))));
             }
-            let re_s = if fixed { format!("{re:.10}") } else { format!("{re:.9e}") };
-            let _ = write!(out, " {re_s:>15}");
+            row.push(if fixed { format!("{re:.10}") } else { format!("{re:.9e}") });
             for (o, x) in self.outcomes.iter().zip(ours) {
-                let f32_col = o.precision.name() == "f32";
-                let _ = write!(out, " {} {:>7}", fmt_ours(x, f32_col, fixed), fmt_err(relative_error(x, re)));
+                row.push(fmt_ours(x, o.precision.name() == "f32", fixed));
+                row.push(fmt_err(relative_error(x, re)));
             }
-            out.push('\n');
+            row
         };
 
         if let Some(rs) = r.sphere_to_face {
             let _ = writeln!(out, "\nTable 1. Sphere -> face, eq. (25). Reference: exact 1/6.");
-            header(&mut out, "face");
+            let mut rows = header("face");
             for (f, &re) in rs.iter().enumerate() {
                 let ours = self
                     .outcomes
                     .iter()
                     .map(|o| o.values.sphere_to_face.and_then(|s| s.get(f).copied()).unwrap_or(f64::NAN))
                     .collect();
-                line(&mut out, (f + 1).to_string(), self.paper.map(|p| p.sphere_to_face(f + 1)), re, ours, false);
+                rows.push(line((f + 1).to_string(), self.paper.map(|p| p.sphere_to_face(f + 1)), re, ours, false));
             }
+            out.push_str(&columns(rows, &widths));
         }
 
         let _ = writeln!(
@@ -469,25 +478,27 @@ impl Report {
                 Source::Unavailable(_) => "unavailable",
             }
         );
-        header(&mut out, "pair");
+        let mut rows = header("pair");
         for (k, &(a, b)) in FACE_PAIRS.iter().enumerate() {
             let re = r.face_to_face.get(k).copied().unwrap_or(f64::NAN);
             let ours =
                 self.outcomes.iter().map(|o| o.values.face_to_face.get(k).copied().unwrap_or(f64::NAN)).collect();
-            line(&mut out, pair_key(a, b), self.paper.map(|p| p.face_to_face(a, b)), re, ours, false);
+            rows.push(line(pair_key(a, b), self.paper.map(|p| p.face_to_face(a, b)), re, ours, false));
         }
+        out.push_str(&columns(rows, &widths));
 
         if let Some(rs) = r.face_to_sphere {
             let _ = writeln!(out, "\nFace -> sphere by reciprocity, A_s F_s->f / A_f. Reference: 4 pi R^2 / 216.");
-            header(&mut out, "face");
+            let mut rows = header("face");
             for (f, &re) in rs.iter().enumerate() {
                 let ours = self
                     .outcomes
                     .iter()
                     .map(|o| o.values.face_to_sphere.and_then(|s| s.get(f).copied()).unwrap_or(f64::NAN))
                     .collect();
-                line(&mut out, (f + 1).to_string(), None, re, ours, false);
+                rows.push(line((f + 1).to_string(), None, re, ours, false));
             }
+            out.push_str(&columns(rows, &widths));
         }
 
         let _ = writeln!(
@@ -495,11 +506,12 @@ impl Report {
             "\nTable 4. Sum of each face's factors (other faces{}). Reference: 1.",
             if c.radius > 0.0 { " + sphere" } else { "" }
         );
-        header(&mut out, "face");
+        let mut rows = header("face");
         for (f, &re) in r.face_sum.iter().enumerate() {
             let ours = self.outcomes.iter().map(|o| o.values.face_sum.get(f).copied().unwrap_or(f64::NAN)).collect();
-            line(&mut out, (f + 1).to_string(), self.paper.and_then(|p| p.face_sum(f + 1)), re, ours, true);
+            rows.push(line((f + 1).to_string(), self.paper.and_then(|p| p.face_sum(f + 1)), re, ours, true));
         }
+        out.push_str(&columns(rows, &widths));
 
         let _ = writeln!(
             out,
@@ -509,11 +521,14 @@ impl Report {
             self.threads,
             if self.threads == 1 { "" } else { "s" }
         );
-        let _ = write!(out, "{:<16} {:>24}", "part", "paper (SPARCstation 1+)");
+        let mut widths = vec![(16, CellAlignment::Left), (24, CellAlignment::Right)];
+        let mut rows = vec![vec!["part".to_string(), "paper (SPARCstation 1+)".into()]];
         for o in &self.outcomes {
-            let _ = write!(out, " {:>12}", format!("ours {}", o.precision.name()));
+            widths.push((12, CellAlignment::Right));
+            if let Some(head) = rows.first_mut() {
+                head.push(format!("ours {}", o.precision.name()));
+            }
         }
-        out.push('\n');
         type Getter = fn(&Outcome) -> f64;
         let parts: [(&str, Option<f64>, Getter); 3] = [
             ("sphere -> face", self.paper.map(|p| p.sphere_face_seconds), Outcome::sphere_face_seconds),
@@ -521,14 +536,13 @@ impl Report {
             ("total", self.paper.map(|p| p.sphere_face_seconds + p.face_face_seconds), Outcome::total_seconds),
         ];
         for (name, paper, get) in parts {
-            let p = paper.map_or("-".into(), paper_duration);
-            let _ = write!(out, "{name:<16} {p:>24}");
+            let mut row = vec![name.to_string(), paper.map_or("-".into(), paper_duration)];
             for o in &self.outcomes {
-                let t = if name == "sphere -> face" && c.radius == 0.0 { "-".into() } else { format_seconds(get(o)) };
-                let _ = write!(out, " {t:>12}");
+                row.push(if name == "sphere -> face" && c.radius == 0.0 { "-".into() } else { format_seconds(get(o)) });
             }
-            out.push('\n');
+            rows.push(row);
         }
+        out.push_str(&columns(rows, &widths));
 
         out.push('\n');
         for note in self.notes() {
@@ -612,22 +626,33 @@ impl Report {
     }
 }
 
-/// Wraps a paragraph at 78 columns, continuation lines indented by two spaces.
-fn wrap(text: &str) -> String {
-    let mut out = String::new();
-    let mut line = String::new();
-    for word in text.split_whitespace() {
-        if !line.is_empty() && line.chars().count() + 1 + word.chars().count() > 78 {
-            out.push_str(&line);
-            out.push('\n');
-            line = "  ".into();
-        }
-        if !line.trim().is_empty() {
-            line.push(' ');
-        }
-        line.push_str(word);
+/// Lays out `rows` in columns of at least the given widths (wider if a cell needs it), one
+/// space apart, without borders; one line per row.
+fn columns(rows: Vec<Vec<String>>, widths: &[(u16, CellAlignment)]) -> String {
+    let mut table = Table::new();
+    table.load_style(presets::NOTHING).set_content_arrangement(ContentArrangement::Disabled);
+    for row in rows {
+        table.add_row(row);
     }
-    out.push_str(&line);
+    for (k, (column, &(width, alignment))) in table.column_iter_mut().zip(widths).enumerate() {
+        let gap = u16::from(k > 0);
+        column
+            .set_padding((gap, 0))
+            .set_constraint(ColumnConstraint::LowerBoundary(Width::Fixed(width + gap)))
+            .set_cell_alignment(alignment);
+    }
+    table.lines().map(|l| l + "\n").collect()
+}
+
+/// Wraps a paragraph at 78 columns, continuation lines indented by two spaces; words are never
+/// broken (not at hyphens either).
+fn wrap(text: &str) -> String {
+    let options = textwrap::Options::new(78)
+        .subsequent_indent("  ")
+        .break_words(false)
+        .wrap_algorithm(textwrap::WrapAlgorithm::FirstFit)
+        .word_splitter(textwrap::WordSplitter::NoHyphenation);
+    let mut out = textwrap::fill(text, options);
     out.push('\n');
     out
 }
