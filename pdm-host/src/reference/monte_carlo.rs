@@ -11,9 +11,10 @@
 //! rays from a uniform point on the sphere with a cosine-weighted direction about the outward
 //! normal.
 //!
-//! Random numbers: xoshiro256** seeded through SplitMix64 (own implementation). The rays are
+//! Random numbers: xoshiro256** ([`rand_xoshiro::Xoshiro256StarStar`], seeded through its
+//! SplitMix64), uniform doubles with 53 random bits (`rand`'s `StandardUniform`). The rays are
 //! split into fixed chunks, each with its own stream derived from `(seed, chunk index)`, and the
-//! chunks are distributed over `std::thread::scope` threads; the integer counts are summed, so
+//! chunks run on rayon's pool (as in [`super::raytrace`]); the integer counts are summed, so
 //! the result depends on the seed and the ray count only, not on the number of threads.
 //!
 //! Values obtained for `l = 6`, `R = 1` with 10⁹ rays from face 1 (seed 2024, release build, 2
@@ -23,6 +24,9 @@
 //! reference 0.1968931066995277 / 0.1542499314687451 / π/54 ([`super::cube`]).
 //! Throughput: ~1e7 rays/s in release on 2 cores, ~2.5e6 rays/s in debug.
 
+use rand::{Rng, RngExt, SeedableRng};
+use rand_xoshiro::{SplitMix64, Xoshiro256StarStar};
+use rayon::prelude::*;
 use std::f64::consts::PI;
 
 /// A Monte Carlo estimate.
@@ -45,49 +49,6 @@ pub struct McCube {
     pub f_opposite: McEstimate,
     /// Face → sphere.
     pub f_face_to_sphere: McEstimate,
-}
-
-/// SplitMix64 step (Steele, Lea & Flood 2014).
-fn splitmix64(state: &mut u64) -> u64 {
-    *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    let mut z = *state;
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
-
-/// xoshiro256** (Blackman & Vigna 2018).
-#[derive(Debug, Clone)]
-pub struct Xoshiro256 {
-    s: [u64; 4],
-}
-
-impl Xoshiro256 {
-    /// Seeds the four state words with SplitMix64.
-    pub fn new(seed: u64) -> Self {
-        let mut sm = seed;
-        let s = [splitmix64(&mut sm), splitmix64(&mut sm), splitmix64(&mut sm), splitmix64(&mut sm)];
-        Self { s }
-    }
-
-    /// Next 64 random bits.
-    pub fn next_u64(&mut self) -> u64 {
-        let [s0, s1, s2, s3] = self.s;
-        let result = s1.wrapping_mul(5).rotate_left(7).wrapping_mul(9);
-        let t = s1 << 17;
-        let mut n = [s0, s1, s2 ^ s0, s3 ^ s1];
-        n[1] ^= n[2];
-        n[0] ^= n[3];
-        n[2] ^= t;
-        n[3] = n[3].rotate_left(45);
-        self.s = n;
-        result
-    }
-
-    /// Uniform in `[0, 1)` with 53 random bits.
-    pub fn next_f64(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
-    }
 }
 
 /// `(axis, sign)`: face plane `x_axis = sign·l/2`, inward normal `−sign·ê_axis`.
@@ -155,9 +116,9 @@ fn trace(p: [f64; 3], d: [f64; 3], h: f64, r: f64, test_sphere: bool) -> usize {
 }
 
 /// Cosine-weighted unit direction about the unit normal `n` with tangents `u`, `v`.
-fn cosine_direction(rng: &mut Xoshiro256, n: [f64; 3], u: [f64; 3], v: [f64; 3]) -> [f64; 3] {
-    let r1 = rng.next_f64();
-    let phi = 2.0 * PI * rng.next_f64();
+fn cosine_direction(rng: &mut Xoshiro256StarStar, n: [f64; 3], u: [f64; 3], v: [f64; 3]) -> [f64; 3] {
+    let r1 = rng.random::<f64>();
+    let phi = 2.0 * PI * rng.random::<f64>();
     let rad = r1.sqrt();
     let (a, b) = (rad * phi.cos(), rad * phi.sin());
     let c = (1.0 - r1).max(0.0).sqrt();
@@ -165,7 +126,7 @@ fn cosine_direction(rng: &mut Xoshiro256, n: [f64; 3], u: [f64; 3], v: [f64; 3])
 }
 
 /// Rays from the face `face` (uniform point, cosine-weighted direction): hit counters.
-fn rays_from_face(rng: &mut Xoshiro256, rays: u64, h: f64, r: f64, axis: usize, sign: f64) -> Counts {
+fn rays_from_face(rng: &mut Xoshiro256StarStar, rays: u64, h: f64, r: f64, axis: usize, sign: f64) -> Counts {
     let mut counts = [0u64; 7];
     let mut n = [0.0; 3];
     let mut u = [0.0; 3];
@@ -187,8 +148,8 @@ fn rays_from_face(rng: &mut Xoshiro256, rays: u64, h: f64, r: f64, axis: usize, 
         }
     }
     for _ in 0..rays {
-        let a = (2.0 * rng.next_f64() - 1.0) * h;
-        let b = (2.0 * rng.next_f64() - 1.0) * h;
+        let a = (2.0 * rng.random::<f64>() - 1.0) * h;
+        let b = (2.0 * rng.random::<f64>() - 1.0) * h;
         let mut p = [0.0; 3];
         for (k, pk) in p.iter_mut().enumerate() {
             *pk = if k == axis {
@@ -209,11 +170,11 @@ fn rays_from_face(rng: &mut Xoshiro256, rays: u64, h: f64, r: f64, axis: usize, 
 }
 
 /// Rays from the sphere (uniform point, cosine-weighted direction about the outward normal).
-fn rays_from_sphere(rng: &mut Xoshiro256, rays: u64, h: f64, r: f64) -> Counts {
+fn rays_from_sphere(rng: &mut Xoshiro256StarStar, rays: u64, h: f64, r: f64) -> Counts {
     let mut counts = [0u64; 7];
     for _ in 0..rays {
-        let z = 2.0 * rng.next_f64() - 1.0;
-        let phi = 2.0 * PI * rng.next_f64();
+        let z = 2.0 * rng.random::<f64>() - 1.0;
+        let phi = 2.0 * PI * rng.random::<f64>();
         let s = (1.0 - z * z).max(0.0).sqrt();
         let n = [s * phi.cos(), s * phi.sin(), z];
         // orthonormal basis (Duff et al. 2017)
@@ -232,46 +193,33 @@ fn rays_from_sphere(rng: &mut Xoshiro256, rays: u64, h: f64, r: f64) -> Counts {
     counts
 }
 
-/// Runs `rays` rays split into chunks with independent streams over the available cores.
+/// The stream of chunk `chunk`: xoshiro256** seeded (through SplitMix64) from the first output of
+/// SplitMix64 started at `seed ⊕ chunk·0xD1B5_4A32_D192_ED03`.
+fn chunk_rng(seed: u64, chunk: u64) -> Xoshiro256StarStar {
+    let mut sm = SplitMix64::seed_from_u64(seed ^ chunk.wrapping_mul(0xD1B5_4A32_D192_ED03));
+    Xoshiro256StarStar::seed_from_u64(sm.next_u64())
+}
+
+/// Chunks of a run: each has its own stream, so a result depends only on the seed and the ray
+/// count.
+const CHUNKS: u64 = 256;
+
+/// Runs `rays` rays split into [`CHUNKS`] chunks with independent streams on rayon's pool and
+/// sums their hit counters.
 fn run_parallel<F>(rays: u64, seed: u64, work: F) -> Counts
 where
-    F: Fn(&mut Xoshiro256, u64) -> Counts + Sync,
+    F: Fn(&mut Xoshiro256StarStar, u64) -> Counts + Sync,
 {
-    let chunks: u64 = 256;
-    let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).clamp(1, 64);
-    let per = rays / chunks;
-    let extra = rays % chunks;
-    let work = &work;
-    let mut total = [0u64; 7];
-    std::thread::scope(|scope| {
-        let handles: Vec<_> = (0..threads as u64)
-            .map(|tid| {
-                scope.spawn(move || {
-                    let mut acc = [0u64; 7];
-                    let mut chunk = tid;
-                    while chunk < chunks {
-                        let n = per + u64::from(chunk < extra);
-                        let mut sm = seed ^ chunk.wrapping_mul(0xD1B5_4A32_D192_ED03);
-                        let mut rng = Xoshiro256::new(splitmix64(&mut sm));
-                        let c = work(&mut rng, n);
-                        for (a, b) in acc.iter_mut().zip(c.iter()) {
-                            *a += b;
-                        }
-                        chunk += threads as u64;
-                    }
-                    acc
-                })
-            })
-            .collect();
-        for hnd in handles {
-            if let Ok(c) = hnd.join() {
-                for (a, b) in total.iter_mut().zip(c.iter()) {
-                    *a += b;
-                }
+    let (per, extra) = (rays / CHUNKS, rays % CHUNKS);
+    (0..CHUNKS).into_par_iter().map(|chunk| work(&mut chunk_rng(seed, chunk), per + u64::from(chunk < extra))).reduce(
+        || [0u64; 7],
+        |mut a, b| {
+            for (x, y) in a.iter_mut().zip(b) {
+                *x += y;
             }
-        }
-    });
-    total
+            a
+        },
+    )
 }
 
 fn estimate(hits: u64, rays: u64, share: f64) -> McEstimate {
@@ -338,21 +286,46 @@ pub fn mc_sphere_to_face(side: f64, radius: f64, face: usize, rays: u64, seed: u
 mod tests {
     use super::*;
 
+    /// The chunk streams are xoshiro256** seeded by SplitMix64 exactly as in the reference C code
+    /// (Vigna): the first outputs for seed 2024, chunk 0, computed independently from that code's
+    /// algorithm.
     #[test]
-    fn xoshiro_reference_sequence() {
+    fn chunk_stream_matches_the_reference_algorithms() {
+        fn splitmix64(state: &mut u64) -> u64 {
+            *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = *state;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            z ^ (z >> 31)
+        }
+        let mut sm = 1234567u64;
+        assert_eq!(splitmix64(&mut sm), 6457827717110365317);
+        assert_eq!(splitmix64(&mut sm), 3203168211198807973);
         // xoshiro256** with state (1, 2, 3, 4): first outputs from the reference C code.
-        let mut r = Xoshiro256 { s: [1, 2, 3, 4] };
-        assert_eq!(r.next_u64(), 11520);
-        assert_eq!(r.next_u64(), 0);
-        assert_eq!(r.next_u64(), 1509978240);
-        assert_eq!(r.next_u64(), 1215971899390074240);
-    }
-
-    #[test]
-    fn splitmix_reference() {
-        // SplitMix64 from seed 1234567: reference outputs
-        let mut s = 1234567u64;
-        assert_eq!(splitmix64(&mut s), 6457827717110365317);
-        assert_eq!(splitmix64(&mut s), 3203168211198807973);
+        let state: Vec<u8> = [1u64, 2, 3, 4].iter().flat_map(|w| w.to_le_bytes()).collect();
+        let mut r = Xoshiro256StarStar::from_seed(state.try_into().unwrap_or_default());
+        assert_eq!(
+            [r.next_u64(), r.next_u64(), r.next_u64(), r.next_u64()],
+            [11520, 0, 1509978240, 1215971899390074240]
+        );
+        for (seed, chunk) in [(2024u64, 0u64), (7, 3), (u64::MAX, 255)] {
+            let mut sm = seed ^ chunk.wrapping_mul(0xD1B5_4A32_D192_ED03);
+            let mut sm2 = splitmix64(&mut sm);
+            let mut s = [splitmix64(&mut sm2), splitmix64(&mut sm2), splitmix64(&mut sm2), splitmix64(&mut sm2)];
+            let mut rng = chunk_rng(seed, chunk);
+            for _ in 0..8 {
+                let out = s[1].wrapping_mul(5).rotate_left(7).wrapping_mul(9);
+                let t = s[1] << 17;
+                s[2] ^= s[0];
+                s[3] ^= s[1];
+                s[1] ^= s[2];
+                s[0] ^= s[3];
+                s[2] ^= t;
+                s[3] = s[3].rotate_left(45);
+                assert_eq!(rng.next_u64(), out);
+            }
+            let u = chunk_rng(seed, chunk).random::<f64>();
+            assert_eq!(u, (chunk_rng(seed, chunk).next_u64() >> 11) as f64 / (1u64 << 53) as f64);
+        }
     }
 }

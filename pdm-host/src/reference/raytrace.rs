@@ -27,14 +27,14 @@
 //! counts when the *first* hit is the receiver on its radiating side; a ray that reaches the
 //! receiver's back is blocked by it. `F = hits/N`, `σ = √(F(1 − F)/N)`.
 //!
-//! Random numbers: xoshiro256++ ([`rand_xoshiro`]). The rays are cut into fixed chunks of
+//! Random numbers: xoshiro256++ ([`rand_xoshiro`]), uniform doubles with 53 random bits (`rand`). The rays are cut into fixed chunks of
 //! [`CHUNK`] rays, chunk `k` drawing from `seed_from_u64(seed ⊕ φ·(k + 1))`; the chunks run on
 //! rayon and the integer counts are summed, so a result depends only on the seed and the ray
 //! count. Throughput ≈ 1e7 rays/s per scene surface on 2 cores (release).
 
 use super::monte_carlo::McEstimate;
 use super::vector::{add, axpy, cross, dot, norm, norm2, scale, sub, V3};
-use rand_core::{Rng, SeedableRng};
+use rand::{RngExt, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -431,8 +431,9 @@ fn tangent_frame(n: V3) -> (V3, V3) {
     }
 }
 
+/// Uniform in `[0, 1)` with 53 random bits.
 fn uniform(rng: &mut Xoshiro256PlusPlus) -> f64 {
-    (rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+    rng.random::<f64>()
 }
 
 /// One ray: whether it reaches the receiver's radiating side first.

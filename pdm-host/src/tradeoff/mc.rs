@@ -7,32 +7,17 @@
 //! F_{sphere→f} is the fraction of rays through face f. Its standard error is
 //! √(F(1 − F)/N), i.e. a relative error of √5/√N for F = 1/6.
 //!
-//! Rays are drawn in chunks of [`CHUNK`] with independent SplitMix64 streams seeded from
+//! Rays are drawn in chunks of [`CHUNK`] with independent SplitMix64 streams
+//! ([`rand_xoshiro::SplitMix64`], uniform doubles with 53 random bits from `rand`) seeded from
 //! (seed, chunk index), so the estimate does not depend on the number of threads; chunks run
 //! on the current rayon pool.
 
+use rand::{RngExt, SeedableRng};
+use rand_xoshiro::SplitMix64;
 use rayon::prelude::*;
 
 /// Rays per independent stream.
 pub const CHUNK: u64 = 1 << 16;
-
-/// SplitMix64 (Steele, Lea, Flood 2014): a small, fast generator with 2⁶⁴ period.
-#[derive(Clone, Debug)]
-struct SplitMix64(u64);
-
-impl SplitMix64 {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    /// Uniform in [0, 1).
-    fn next_f64(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
-    }
-}
 
 /// Face (0-based, the validation's numbering 1..6 minus one) through which the ray p + t·d,
 /// t > 0, leaves the cube |x|, |y|, |z| ≤ h, and the t of the exit point.
@@ -69,19 +54,19 @@ pub fn sphere_rays(
 ) -> Vec<u64> {
     let chunks = rays.div_ceil(CHUNK);
     let per_chunk = |c: u64| {
-        let mut rng = SplitMix64(seed ^ c.wrapping_mul(0xD1B5_4A32_D192_ED03));
+        let mut rng = SplitMix64::seed_from_u64(seed ^ c.wrapping_mul(0xD1B5_4A32_D192_ED03));
         let n = CHUNK.min(rays - c * CHUNK);
         let mut hits = vec![0u64; bins];
         for _ in 0..n {
             // Uniform point on the sphere (Archimedes: z uniform).
-            let z = 1.0 - 2.0 * rng.next_f64();
-            let phi = std::f64::consts::TAU * rng.next_f64();
+            let z = 1.0 - 2.0 * rng.random::<f64>();
+            let phi = std::f64::consts::TAU * rng.random::<f64>();
             let r = (1.0 - z * z).max(0.0).sqrt();
             let nrm = [r * phi.cos(), r * phi.sin(), z];
             // Cosine-distributed direction about the normal (Malley), in an orthonormal frame
             // (Duff et al. 2017).
-            let u1 = rng.next_f64();
-            let a = std::f64::consts::TAU * rng.next_f64();
+            let u1 = rng.random::<f64>();
+            let a = std::f64::consts::TAU * rng.random::<f64>();
             let (lx, ly, lz) = (u1.sqrt() * a.cos(), u1.sqrt() * a.sin(), (1.0 - u1).sqrt());
             let sign = if nrm[2] >= 0.0 { 1.0 } else { -1.0 };
             let aa = -1.0 / (sign + nrm[2]);

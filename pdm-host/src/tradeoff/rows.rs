@@ -1,6 +1,6 @@
 //! The sweep's rows, their CSV form (written and read back, for `--append`), and Pareto fronts.
 
-use std::fmt::Write as _;
+use serde::{Deserialize, Serialize};
 
 /// Columns of `tradeoff.csv`, in order.
 pub const COLUMNS: [&str; 16] = [
@@ -22,8 +22,8 @@ pub const COLUMNS: [&str; 16] = [
     "label",
 ];
 
-/// One sweep point.
-#[derive(Clone, Debug, PartialEq)]
+/// One sweep point (a CSV record: the fields in [`COLUMNS`] order, then the label).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Row {
     /// Case name ([`super::cases::CaseId::name`]).
     pub case: String,
@@ -38,18 +38,24 @@ pub struct Row {
     /// Number of patches.
     pub patches: usize,
     /// Relative tolerance (adaptive mode), else NaN (written empty).
+    #[serde(with = "crate::csv_num")]
     pub tolerance: f64,
     /// The computed value with the largest error.
+    #[serde(with = "crate::csv_num")]
     pub value: f64,
     /// Its reference.
+    #[serde(with = "crate::csv_num")]
     pub reference: f64,
     /// Largest relative error over the case's values.
+    #[serde(with = "crate::csv_num")]
     pub rel_error: f64,
     /// Relative uncertainty of that reference (0 for exact ones).
+    #[serde(with = "crate::csv_num")]
     pub reference_rel_uncertainty: f64,
     /// Kernel evaluations.
     pub evaluations: u64,
     /// Median wall time, seconds.
+    #[serde(with = "crate::csv_num")]
     pub seconds: f64,
     /// Timed repetitions.
     pub repeats: usize,
@@ -73,89 +79,27 @@ impl Row {
     }
 }
 
-fn num(x: f64) -> String {
-    if x.is_nan() {
-        String::new()
-    } else {
-        format!("{x:e}")
-    }
-}
-
 /// The CSV text (header and rows).
 #[must_use]
 pub fn to_csv(rows: &[Row]) -> String {
-    let mut s = COLUMNS.join(",");
-    s.push('\n');
+    let mut w = csv::WriterBuilder::new().has_headers(false).from_writer(Vec::new());
+    // Writing to memory fails only on a serialization error, which these plain fields cannot raise.
+    let _ = w.write_record(COLUMNS);
     for r in rows {
-        let _ = writeln!(
-            s,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
-            r.case,
-            r.precision,
-            r.mode,
-            r.order,
-            r.grid,
-            r.patches,
-            num(r.tolerance),
-            num(r.value),
-            num(r.reference),
-            num(r.rel_error),
-            num(r.reference_rel_uncertainty),
-            r.evaluations,
-            num(r.seconds),
-            r.repeats,
-            r.threads,
-            r.label(),
-        );
+        let _ = w.serialize((r, r.label()));
     }
-    s
+    w.into_inner().map(|b| String::from_utf8_lossy(&b).into_owned()).unwrap_or_default()
 }
 
-/// Reads a CSV written by [`to_csv`]. Errors name the line.
+/// Reads a CSV written by [`to_csv`] (columns by name; the label is ignored). Errors name the
+/// line.
 pub fn from_csv(text: &str) -> Result<Vec<Row>, String> {
-    let mut lines = text.lines();
-    let header = lines.next().unwrap_or_default();
-    if header.split(',').collect::<Vec<_>>() != COLUMNS {
-        return Err(format!("unexpected CSV header {header:?}"));
+    let mut r = csv::Reader::from_reader(text.as_bytes());
+    let header = r.headers().map_err(|e| format!("CSV header: {e}"))?;
+    if header.iter().ne(COLUMNS) {
+        return Err(format!("unexpected CSV header {:?}", header.iter().collect::<Vec<_>>().join(",")));
     }
-    let mut rows = Vec::new();
-    for (k, line) in lines.enumerate() {
-        if line.trim().is_empty() {
-            continue;
-        }
-        let f: Vec<&str> = line.split(',').collect();
-        let bad = |what: &str| format!("CSV line {}: bad {what}: {line:?}", k + 2);
-        let [case, precision, mode, order, grid, patches, tolerance, value, reference, rel_error, unc, evaluations, seconds, repeats, threads, _label] =
-            f.as_slice()
-        else {
-            return Err(bad("field count"));
-        };
-        let float = |s: &str, what: &str| -> Result<f64, String> {
-            if s.is_empty() {
-                Ok(f64::NAN)
-            } else {
-                s.parse().map_err(|_| bad(what))
-            }
-        };
-        rows.push(Row {
-            case: (*case).to_string(),
-            precision: (*precision).to_string(),
-            mode: (*mode).to_string(),
-            order: order.parse().map_err(|_| bad("order"))?,
-            grid: (*grid).to_string(),
-            patches: patches.parse().map_err(|_| bad("patches"))?,
-            tolerance: float(tolerance, "tolerance")?,
-            value: float(value, "value")?,
-            reference: float(reference, "reference")?,
-            rel_error: float(rel_error, "rel_error")?,
-            reference_rel_uncertainty: float(unc, "reference_rel_uncertainty")?,
-            evaluations: evaluations.parse().map_err(|_| bad("evaluations"))?,
-            seconds: float(seconds, "seconds")?,
-            repeats: repeats.parse().map_err(|_| bad("repeats"))?,
-            threads: threads.parse().map_err(|_| bad("threads"))?,
-        });
-    }
-    Ok(rows)
+    r.deserialize().map(|row| row.map_err(|e| format!("CSV: {e}"))).collect()
 }
 
 /// Indices of the Pareto front of (time, error) points: sorted by time, each point whose error
@@ -224,6 +168,12 @@ mod tests {
         assert_eq!(back[0].seconds, 0.5);
         assert_eq!(back[1].label(), "adaptive f64 tol=1e-6 grid 4x8/3");
         assert!(from_csv("a,b\n").is_err());
+        assert!(from_csv(&to_csv(&rows).replace("5e-1", "half")).is_err());
+        // The text: `{:e}` numbers, NaN empty, the label last.
+        assert_eq!(
+            to_csv(&rows).lines().nth(1),
+            Some("far,f64,paper,5,4x8/3,86,,1e-1,1e-1,1e-3,0e0,123,5e-1,3,2,paper f64 p=5 grid 4x8/3")
+        );
     }
 
     #[test]

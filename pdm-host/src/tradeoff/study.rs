@@ -16,7 +16,6 @@
 //! exact factor to each cell ([`exact_floor`]) gives the **error floor** that no quadrature can
 //! go below: the polygonisation error itself. All in f64.
 
-use std::fmt::Write as _;
 use std::time::Instant;
 
 use pdm_kernel::{Patch, PatchGrid, Surface};
@@ -52,8 +51,8 @@ pub const COLUMNS: [&str; 14] = [
     "threads",
 ];
 
-/// One point of the study.
-#[derive(Clone, Debug, PartialEq)]
+/// One point of the study (a CSV record, fields in [`COLUMNS`] order).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct StudyRow {
     /// "curved-paper", "curved-pair", "curved-adaptive", "uv-8x16", "ico-2", "monte-carlo".
     pub approach: String,
@@ -66,20 +65,25 @@ pub struct StudyRow {
     /// Gauss order (0: adaptive or Monte Carlo).
     pub order: usize,
     /// Tolerance (adaptive), else NaN.
+    #[serde(with = "crate::csv_num")]
     pub tolerance: f64,
     /// Rays (Monte Carlo), else 0.
     pub rays: u64,
     /// The cell value with the largest error.
+    #[serde(with = "crate::csv_num")]
     pub value: f64,
     /// Largest relative error over the 54 cells against the sphere's exact values (Monte Carlo:
     /// root mean square over the repetitions' seeds).
+    #[serde(with = "crate::csv_num")]
     pub rel_error: f64,
     /// The polyhedron's exact largest relative deviation from the sphere's values (NaN for the
     /// sphere and Monte Carlo).
+    #[serde(with = "crate::csv_num")]
     pub polygon_floor: f64,
     /// Kernel evaluations (rays for Monte Carlo).
     pub evaluations: u64,
     /// Median wall time, seconds.
+    #[serde(with = "crate::csv_num")]
     pub seconds: f64,
     /// Repetitions.
     pub repeats: usize,
@@ -87,40 +91,16 @@ pub struct StudyRow {
     pub threads: usize,
 }
 
-fn num(x: f64) -> String {
-    if x.is_nan() {
-        String::new()
-    } else {
-        format!("{x:e}")
-    }
-}
-
 /// The CSV text.
 #[must_use]
 pub fn to_csv(rows: &[StudyRow]) -> String {
-    let mut s = COLUMNS.join(",");
-    s.push('\n');
+    let mut w = csv::WriterBuilder::new().has_headers(false).from_writer(Vec::new());
+    // Writing to memory fails only on a serialization error, which these plain fields cannot raise.
+    let _ = w.write_record(COLUMNS);
     for r in rows {
-        let _ = writeln!(
-            s,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
-            r.approach,
-            r.family,
-            r.grid,
-            r.elements,
-            r.order,
-            num(r.tolerance),
-            r.rays,
-            num(r.value),
-            num(r.rel_error),
-            num(r.polygon_floor),
-            r.evaluations,
-            num(r.seconds),
-            r.repeats,
-            r.threads
-        );
+        let _ = w.serialize(r);
     }
-    s
+    w.into_inner().map(|b| String::from_utf8_lossy(&b).into_owned()).unwrap_or_default()
 }
 
 /// The receivers' polygons (faces 1..6, each 3 × 3 cells in `PatchGrid` order).

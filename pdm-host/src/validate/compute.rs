@@ -40,7 +40,7 @@ pub struct Values {
 }
 
 /// Wall times of one computation, seconds.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Times {
     /// Sphere → face part (sampling included).
     pub sphere_face: f64,

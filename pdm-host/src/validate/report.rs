@@ -1,10 +1,14 @@
 //! Rendering a `validate` run: an 80-column table shaped like the paper's tables with our
 //! columns added, the JSON contract, or CSV.
 
+use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
-use serde_json::{json, Map, Value};
+use comfy_table::{presets, CellAlignment, ColumnConstraint, ContentArrangement, Table, Width};
+use serde::Serialize;
+use serde_json::{Map, Value};
 
+use super::compute::Times;
 use super::paper::{paper_duration, PaperValues};
 use super::reference::{Reference, Source};
 use super::scene::{pair_key, FACE_PAIRS};
@@ -39,123 +43,233 @@ fn rel_errors(ours: &[f64], reference: &[f64]) -> Vec<f64> {
     ours.iter().zip(reference).map(|(&o, &r)| relative_error(o, r)).collect()
 }
 
-fn pair_object(values: &[f64; 15]) -> Value {
-    let mut m = Map::new();
-    for (&(a, b), &v) in FACE_PAIRS.iter().zip(values) {
-        m.insert(pair_key(a, b), json!(v));
+/// Values per face pair, keyed "1-2" … "5-6".
+type PairMap = BTreeMap<String, f64>;
+
+fn pair_object(values: &[f64; 15]) -> PairMap {
+    FACE_PAIRS.iter().zip(values).map(|(&(a, b), &v)| (pair_key(a, b), v)).collect()
+}
+
+/// The settings of a run (part of the JSON document; also the CSV's setting rows).
+#[derive(Serialize)]
+struct SettingsJson {
+    command: &'static str,
+    mode: &'static str,
+    precision: &'static str,
+    patches: usize,
+    patches_option: Option<usize>,
+    sphere_grid: Option<[usize; 2]>,
+    face_grid: usize,
+    order: usize,
+    singular_order: Option<usize>,
+    tolerance: Option<f64>,
+    sphere_radius: f64,
+    repeat: usize,
+    threads: usize,
+}
+
+#[derive(Serialize)]
+struct ReferenceJson<'a> {
+    sphere_to_face: &'a Option<[f64; 6]>,
+    face_to_sphere: &'a Option<[f64; 6]>,
+    face_to_face: PairMap,
+    face_sum: &'a [f64; 6],
+    face_to_face_uncertainty: PairMap,
+    source: String,
+    sum_rule_residual: f64,
+    seconds: f64,
+}
+
+#[derive(Serialize)]
+struct PaperSecondsJson {
+    sphere_face: f64,
+    face_face: f64,
+}
+
+#[derive(Serialize)]
+struct PaperJson {
+    patches: usize,
+    sphere_to_face: Vec<f64>,
+    face_to_face: PairMap,
+    face_sum: Vec<Option<f64>>,
+    seconds: PaperSecondsJson,
+}
+
+#[derive(Serialize)]
+struct RelativeErrorJson {
+    sphere_to_face: Option<Vec<f64>>,
+    face_to_sphere: Option<Vec<f64>>,
+    face_to_face: PairMap,
+    face_sum: Vec<f64>,
+}
+
+#[derive(Serialize)]
+struct TimingJson<'a> {
+    sphere_face: f64,
+    face_face: f64,
+    runs: &'a [Times],
+    reference: f64,
+}
+
+/// One precision's document; a second precision is nested under its name ("f32").
+#[derive(Serialize)]
+struct OutcomeJson<'a> {
+    #[serde(flatten)]
+    settings: SettingsJson,
+    sphere_to_face: &'a Option<[f64; 6]>,
+    face_to_sphere: &'a Option<[f64; 6]>,
+    face_to_face: PairMap,
+    face_sum: &'a [f64; 6],
+    estimated_error: Option<f64>,
+    unconverged_pairs: Option<u64>,
+    reference: ReferenceJson<'a>,
+    relative_error: RelativeErrorJson,
+    paper: Option<PaperJson>,
+    seconds: f64,
+    timing: TimingJson<'a>,
+    #[serde(flatten)]
+    other_precisions: BTreeMap<&'static str, OutcomeJson<'a>>,
+}
+
+/// Columns of the `--format csv` output.
+pub const CSV_COLUMNS: [&str; 8] =
+    ["table", "item", "precision", "paper", "ours", "reference", "relative_error", "reference_uncertainty"];
+
+/// The `ours` column: a value, or a setting's text.
+#[derive(Serialize)]
+#[serde(untagged)]
+enum CsvCell {
+    Number(#[serde(with = "crate::csv_num")] f64),
+    Text(String),
+}
+
+/// One record of the `--format csv` output ([`CSV_COLUMNS`]); NaN is an empty field.
+#[derive(Serialize)]
+struct CsvRow {
+    table: &'static str,
+    item: String,
+    precision: &'static str,
+    #[serde(with = "crate::csv_num")]
+    paper: f64,
+    ours: CsvCell,
+    #[serde(with = "crate::csv_num")]
+    reference: f64,
+    #[serde(with = "crate::csv_num")]
+    relative_error: f64,
+    #[serde(with = "crate::csv_num")]
+    reference_uncertainty: f64,
+}
+
+impl CsvRow {
+    /// A row with text in `ours` and no reference.
+    fn text(table: &'static str, item: String, precision: &'static str, paper: Option<f64>, ours: &str) -> Self {
+        Self {
+            table,
+            item,
+            precision,
+            paper: paper.unwrap_or(f64::NAN),
+            ours: CsvCell::Text(ours.into()),
+            reference: f64::NAN,
+            relative_error: f64::NAN,
+            reference_uncertainty: f64::NAN,
+        }
     }
-    Value::Object(m)
 }
 
 impl Report {
-    fn settings_json(&self, o: &Outcome) -> Map<String, Value> {
+    fn settings_json(&self, o: &Outcome) -> SettingsJson {
         let c = &self.config;
-        let mut m = Map::new();
-        m.insert("command".into(), json!("validate"));
-        m.insert("mode".into(), json!(c.mode.name()));
-        m.insert("precision".into(), json!(o.precision.name()));
-        m.insert("patches".into(), json!(c.total_patches()));
-        m.insert("patches_option".into(), json!(self.patches));
-        m.insert(
-            "sphere_grid".into(),
-            if c.radius > 0.0 { json!([c.sphere_grid.0, c.sphere_grid.1]) } else { Value::Null },
-        );
-        m.insert("face_grid".into(), json!(c.face_grid));
-        m.insert("order".into(), json!(c.order));
-        m.insert("singular_order".into(), if c.mode == Mode::Accurate { json!(c.singular_order) } else { Value::Null });
-        m.insert("tolerance".into(), c.tolerance.map_or(Value::Null, |t| json!(t)));
-        m.insert("sphere_radius".into(), json!(c.radius));
-        m.insert("repeat".into(), json!(self.repeat));
-        m.insert("threads".into(), json!(self.threads));
-        m
+        SettingsJson {
+            command: "validate",
+            mode: c.mode.name(),
+            precision: o.precision.name(),
+            patches: c.total_patches(),
+            patches_option: self.patches,
+            sphere_grid: (c.radius > 0.0).then_some([c.sphere_grid.0, c.sphere_grid.1]),
+            face_grid: c.face_grid,
+            order: c.order,
+            singular_order: (c.mode == Mode::Accurate).then_some(c.singular_order),
+            tolerance: c.tolerance,
+            sphere_radius: c.radius,
+            repeat: self.repeat,
+            threads: self.threads,
+        }
     }
 
-    fn reference_json(&self) -> Value {
+    fn reference_json(&self) -> ReferenceJson<'_> {
         let r = &self.reference;
-        let mut unc = Map::new();
-        for (&(a, b), &u) in FACE_PAIRS.iter().zip(&r.face_to_face_uncertainty) {
-            unc.insert(pair_key(a, b), json!(u));
-        }
-        json!({
-            "sphere_to_face": r.sphere_to_face,
-            "face_to_sphere": r.face_to_sphere,
-            "face_to_face": pair_object(&r.face_to_face),
-            "face_sum": r.face_sum,
-            "face_to_face_uncertainty": Value::Object(unc),
-            "source": match &r.source {
+        ReferenceJson {
+            sphere_to_face: &r.sphere_to_face,
+            face_to_sphere: &r.face_to_sphere,
+            face_to_face: pair_object(&r.face_to_face),
+            face_sum: &r.face_sum,
+            face_to_face_uncertainty: pair_object(&r.face_to_face_uncertainty),
+            source: match &r.source {
                 Source::ClosedForm => "closed_form (C-11, C-14)".to_string(),
                 Source::Independent => "pdm_host::reference::cube".to_string(),
                 Source::Stored => "pdm_host::reference::cube (stored for R = 1)".to_string(),
                 Source::Unavailable(why) => format!("unavailable: {why}"),
             },
-            "sum_rule_residual": r.sum_rule_residual(),
-            "seconds": r.seconds,
-        })
+            sum_rule_residual: r.sum_rule_residual(),
+            seconds: r.seconds,
+        }
     }
 
-    fn paper_json(&self) -> Value {
-        let Some(p) = self.paper else {
-            return Value::Null;
-        };
-        let s2f: Vec<f64> = (1..=6).map(|f| p.sphere_to_face(f)).collect();
+    fn paper_json(&self) -> Option<PaperJson> {
+        let p = self.paper?;
         let mut ff = [0.0; 15];
         for (&(a, b), v) in FACE_PAIRS.iter().zip(&mut ff) {
             *v = p.face_to_face(a, b);
         }
-        let sums: Vec<Option<f64>> = (1..=6).map(|f| p.face_sum(f)).collect();
-        json!({
-            "patches": p.patches,
-            "sphere_to_face": s2f,
-            "face_to_face": pair_object(&ff),
-            "face_sum": sums,
-            "seconds": {"sphere_face": p.sphere_face_seconds, "face_face": p.face_face_seconds},
+        Some(PaperJson {
+            patches: p.patches,
+            sphere_to_face: (1..=6).map(|f| p.sphere_to_face(f)).collect(),
+            face_to_face: pair_object(&ff),
+            face_sum: (1..=6).map(|f| p.face_sum(f)).collect(),
+            seconds: PaperSecondsJson { sphere_face: p.sphere_face_seconds, face_face: p.face_face_seconds },
         })
     }
 
-    fn outcome_json(&self, o: &Outcome) -> Map<String, Value> {
+    fn outcome_json<'a>(&'a self, o: &'a Outcome) -> OutcomeJson<'a> {
         let v = &o.values;
         let r = &self.reference;
-        let mut m = self.settings_json(o);
-        m.insert("sphere_to_face".into(), json!(v.sphere_to_face));
-        m.insert("face_to_sphere".into(), json!(v.face_to_sphere));
-        m.insert("face_to_face".into(), pair_object(&v.face_to_face));
-        m.insert("face_sum".into(), json!(v.face_sum));
-        m.insert("estimated_error".into(), json!(v.estimated_error));
-        m.insert("unconverged_pairs".into(), json!(v.unconverged_pairs));
-        m.insert("reference".into(), self.reference_json());
         let mut ff_err = [0.0; 15];
         for ((e, &ours), &re) in ff_err.iter_mut().zip(&v.face_to_face).zip(&r.face_to_face) {
             *e = relative_error(ours, re);
         }
         let pair_err = |ours: &Option<[f64; 6]>, re: &Option<[f64; 6]>| match (ours, re) {
-            (Some(a), Some(b)) => json!(rel_errors(a, b)),
-            _ => Value::Null,
+            (Some(a), Some(b)) => Some(rel_errors(a, b)),
+            _ => None,
         };
-        m.insert(
-            "relative_error".into(),
-            json!({
-                "sphere_to_face": pair_err(&v.sphere_to_face, &r.sphere_to_face),
-                "face_to_sphere": pair_err(&v.face_to_sphere, &r.face_to_sphere),
-                "face_to_face": pair_object(&ff_err),
-                "face_sum": rel_errors(&v.face_sum, &r.face_sum),
-            }),
-        );
-        m.insert("paper".into(), self.paper_json());
-        m.insert("seconds".into(), json!(o.total_seconds()));
-        m.insert(
-            "timing".into(),
-            json!({
-                "sphere_face": o.sphere_face_seconds(),
-                "face_face": o.face_face_seconds(),
-                "runs": o.times.iter().map(|t| json!({"sphere_face": t.sphere_face, "face_face": t.face_face})).collect::<Vec<_>>(),
-                "reference": r.seconds,
-            }),
-        );
-        m
+        OutcomeJson {
+            settings: self.settings_json(o),
+            sphere_to_face: &v.sphere_to_face,
+            face_to_sphere: &v.face_to_sphere,
+            face_to_face: pair_object(&v.face_to_face),
+            face_sum: &v.face_sum,
+            estimated_error: v.estimated_error,
+            unconverged_pairs: v.unconverged_pairs,
+            reference: self.reference_json(),
+            relative_error: RelativeErrorJson {
+                sphere_to_face: pair_err(&v.sphere_to_face, &r.sphere_to_face),
+                face_to_sphere: pair_err(&v.face_to_sphere, &r.face_to_sphere),
+                face_to_face: pair_object(&ff_err),
+                face_sum: rel_errors(&v.face_sum, &r.face_sum),
+            },
+            paper: self.paper_json(),
+            seconds: o.total_seconds(),
+            timing: TimingJson {
+                sphere_face: o.sphere_face_seconds(),
+                face_face: o.face_face_seconds(),
+                runs: &o.times,
+                reference: r.seconds,
+            },
+            other_precisions: BTreeMap::new(),
+        }
     }
 
     /// The JSON document (`--format json`): the first outcome's object; with two precisions the
-    /// f32 outcome is nested under the key "f32".
+    /// f32 outcome is nested under the key "f32". Keys are sorted.
     #[must_use]
     pub fn to_json(&self) -> Value {
         let mut iter = self.outcomes.iter();
@@ -163,44 +277,54 @@ impl Report {
             return Value::Null;
         };
         let mut top = self.outcome_json(first);
-        for o in iter {
-            top.insert(o.precision.name().into(), Value::Object(self.outcome_json(o)));
-        }
-        Value::Object(top)
+        top.other_precisions = iter.map(|o| (o.precision.name(), self.outcome_json(o))).collect();
+        serde_json::to_value(top).unwrap_or(Value::Null)
     }
 
-    /// CSV (`--format csv`): one row per value and precision, then timing and setting rows.
+    /// CSV (`--format csv`): one row per value and precision, then timing and setting rows
+    /// ([`CSV_COLUMNS`]).
     #[must_use]
     pub fn to_csv(&self) -> String {
-        let mut out = String::from("table,item,precision,paper,ours,reference,relative_error,reference_uncertainty\n");
-        let num = |x: Option<f64>| x.map_or(String::new(), |x| format!("{x:e}"));
+        let mut w = csv::WriterBuilder::new().has_headers(false).from_writer(Vec::new());
+        // Writing to memory fails only on a serialization error, which these plain fields cannot raise.
+        let _ = w.write_record(CSV_COLUMNS);
+        for row in self.csv_rows() {
+            let _ = w.serialize(row);
+        }
+        w.into_inner().map(|b| String::from_utf8_lossy(&b).into_owned()).unwrap_or_default()
+    }
+
+    fn csv_rows(&self) -> Vec<CsvRow> {
+        let mut rows = Vec::new();
         let r = &self.reference;
+        let value = |table: &'static str,
+                     item: String,
+                     precision: &'static str,
+                     paper: Option<f64>,
+                     ours: f64,
+                     re: f64,
+                     unc: f64| CsvRow {
+            table,
+            item,
+            precision,
+            paper: paper.unwrap_or(f64::NAN),
+            ours: CsvCell::Number(ours),
+            reference: re,
+            relative_error: relative_error(ours, re),
+            reference_uncertainty: unc,
+        };
         for o in &self.outcomes {
             let p = o.precision.name();
             let v = &o.values;
-            let mut row = |table: &str, item: String, paper: Option<f64>, ours: f64, re: f64, unc: f64| {
-                let _ = writeln!(
-                    out,
-                    "{table},{item},{p},{},{ours:e},{re:e},{:e},{unc:e}",
-                    num(paper),
-                    relative_error(ours, re)
-                );
-            };
             if let (Some(s), Some(rs)) = (v.sphere_to_face, r.sphere_to_face) {
                 for (f, (&x, &y)) in s.iter().zip(&rs).enumerate() {
-                    row(
-                        "sphere_to_face",
-                        (f + 1).to_string(),
-                        self.paper.map(|pv| pv.sphere_to_face(f + 1)),
-                        x,
-                        y,
-                        0.0,
-                    );
+                    let paper = self.paper.map(|pv| pv.sphere_to_face(f + 1));
+                    rows.push(value("sphere_to_face", (f + 1).to_string(), p, paper, x, y, 0.0));
                 }
             }
             if let (Some(s), Some(rs)) = (v.face_to_sphere, r.face_to_sphere) {
                 for (f, (&x, &y)) in s.iter().zip(&rs).enumerate() {
-                    row("face_to_sphere", (f + 1).to_string(), None, x, y, 0.0);
+                    rows.push(value("face_to_sphere", (f + 1).to_string(), p, None, x, y, 0.0));
                 }
             }
             for (k, &(a, b)) in FACE_PAIRS.iter().enumerate() {
@@ -209,10 +333,19 @@ impl Report {
                     r.face_to_face.get(k).copied().unwrap_or(f64::NAN),
                     r.face_to_face_uncertainty.get(k).copied().unwrap_or(f64::NAN),
                 );
-                row("face_to_face", pair_key(a, b), self.paper.map(|pv| pv.face_to_face(a, b)), x, y, u);
+                rows.push(value(
+                    "face_to_face",
+                    pair_key(a, b),
+                    p,
+                    self.paper.map(|pv| pv.face_to_face(a, b)),
+                    x,
+                    y,
+                    u,
+                ));
             }
             for (f, (&x, &y)) in v.face_sum.iter().zip(&r.face_sum).enumerate() {
-                row("face_sum", (f + 1).to_string(), self.paper.and_then(|pv| pv.face_sum(f + 1)), x, y, 0.0);
+                let paper = self.paper.and_then(|pv| pv.face_sum(f + 1));
+                rows.push(value("face_sum", (f + 1).to_string(), p, paper, x, y, 0.0));
             }
             let secs = [
                 ("sphere_face", self.paper.map(|pv| pv.sphere_face_seconds), o.sphere_face_seconds()),
@@ -220,11 +353,15 @@ impl Report {
                 ("total", self.paper.map(|pv| pv.sphere_face_seconds + pv.face_face_seconds), o.total_seconds()),
             ];
             for (item, paper, ours) in secs {
-                let _ = writeln!(out, "seconds,{item},{p},{},{ours:e},,,", num(paper));
+                rows.push(CsvRow { ours: CsvCell::Number(ours), ..CsvRow::text("seconds", item.into(), p, paper, "") });
             }
         }
         if let Some(first) = self.outcomes.first() {
-            for (k, val) in self.settings_json(first) {
+            let settings = match serde_json::to_value(self.settings_json(first)) {
+                Ok(Value::Object(m)) => m,
+                _ => Map::new(),
+            };
+            for (k, val) in settings {
                 if k == "precision" {
                     continue;
                 }
@@ -233,12 +370,12 @@ impl Report {
                     Value::Null => String::new(),
                     other => other.to_string().replace(',', "x").replace(['[', ']'], ""),
                 };
-                let _ = writeln!(out, "setting,{k},,,{text},,,");
+                rows.push(CsvRow::text("setting", k, "", None, &text));
             }
             let precisions: Vec<&str> = self.outcomes.iter().map(|o| o.precision.name()).collect();
-            let _ = writeln!(out, "setting,precision,,,{},,,", precisions.join(" "));
+            rows.push(CsvRow::text("setting", "precision".into(), "", None, &precisions.join(" ")));
         }
-        out
+        rows
     }
 
     /// The human-readable tables (≤ 80 columns).
@@ -271,56 +408,64 @@ impl Report {
             Some(p) => format!("paper {}", p.patches),
             None => "paper".into(),
         };
-        // Header: item, paper, [paper err], reference, per outcome: ours, rel.err
-        let header = |out: &mut String, item: &str| {
-            let _ = write!(out, "{item:>5} {paper_name:>10}");
+        // Columns: item, paper, [paper err], reference, per outcome: ours, rel.err (minimum widths).
+        let mut widths: Vec<(u16, CellAlignment)> = vec![(5, CellAlignment::Right), (10, CellAlignment::Right)];
+        if !two {
+            widths.push((8, CellAlignment::Right));
+        }
+        widths.push((15, CellAlignment::Right));
+        for o in &self.outcomes {
+            widths.push((if o.precision.name() == "f32" && two { 13 } else { 15 }, CellAlignment::Right));
+            widths.push((7, CellAlignment::Right));
+        }
+        let header = |item: &str| {
+            let mut row = vec![item.to_string(), paper_name.clone()];
             if !two {
-                let _ = write!(out, " {:>8}", "p.err");
+                row.push("p.err".into());
             }
-            let _ = write!(out, " {:>15}", "reference");
+            row.push("reference".into());
             for o in &self.outcomes {
-                let w = if o.precision.name() == "f32" && two { 13 } else { 15 };
-                let _ = write!(out, " {:>w$} {:>7}", format!("ours {}", o.precision.name()), "rel.err");
+                row.push(format!("ours {}", o.precision.name()));
+                row.push("rel.err".into());
             }
-            out.push('\n');
+            vec![row]
         };
         let fmt_ours = |x: f64, f32_col: bool, fixed: bool| match (fixed, f32_col && two) {
-            (true, true) => format!("{x:>13.8}"),
-            (true, false) => format!("{x:>15.10}"),
-            (false, true) => format!("{x:>13.7e}"),
-            (false, false) => format!("{x:>15.9e}"),
+            (true, true) => format!("{x:.8}"),
+            (true, false) => format!("{x:.10}"),
+            (false, true) => format!("{x:.7e}"),
+            (false, false) => format!("{x:.9e}"),
         };
-        let line = |out: &mut String, item: String, paper: Option<f64>, re: f64, ours: Vec<f64>, fixed: bool| {
+        let line = |item: String, paper: Option<f64>, re: f64, ours: Vec<f64>, fixed: bool| {
             let p = match paper {
                 Some(p) if fixed => format!("{p:.4}"),
                 Some(p) => format!("{p:.4e}"),
                 None => "-".into(),
             };
-            let _ = write!(out, "{item:>5} {p:>10}");
+            let mut row = vec![item, p];
             if !two {
-                let pe = paper.map_or("-".into(), |p| fmt_err(relative_error(p, re)));
-                let _ = write!(out, " {pe:>8}");
+                row.push(paper.map_or("-".into(), |p| fmt_err(relative_error(p, re))));
             }
-            let re_s = if fixed { format!("{re:.10}") } else { format!("{re:.9e}") };
-            let _ = write!(out, " {re_s:>15}");
+            row.push(if fixed { format!("{re:.10}") } else { format!("{re:.9e}") });
             for (o, x) in self.outcomes.iter().zip(ours) {
-                let f32_col = o.precision.name() == "f32";
-                let _ = write!(out, " {} {:>7}", fmt_ours(x, f32_col, fixed), fmt_err(relative_error(x, re)));
+                row.push(fmt_ours(x, o.precision.name() == "f32", fixed));
+                row.push(fmt_err(relative_error(x, re)));
             }
-            out.push('\n');
+            row
         };
 
         if let Some(rs) = r.sphere_to_face {
             let _ = writeln!(out, "\nTable 1. Sphere -> face, eq. (25). Reference: exact 1/6.");
-            header(&mut out, "face");
+            let mut rows = header("face");
             for (f, &re) in rs.iter().enumerate() {
                 let ours = self
                     .outcomes
                     .iter()
                     .map(|o| o.values.sphere_to_face.and_then(|s| s.get(f).copied()).unwrap_or(f64::NAN))
                     .collect();
-                line(&mut out, (f + 1).to_string(), self.paper.map(|p| p.sphere_to_face(f + 1)), re, ours, false);
+                rows.push(line((f + 1).to_string(), self.paper.map(|p| p.sphere_to_face(f + 1)), re, ours, false));
             }
+            out.push_str(&columns(rows, &widths));
         }
 
         let _ = writeln!(
@@ -333,25 +478,27 @@ impl Report {
                 Source::Unavailable(_) => "unavailable",
             }
         );
-        header(&mut out, "pair");
+        let mut rows = header("pair");
         for (k, &(a, b)) in FACE_PAIRS.iter().enumerate() {
             let re = r.face_to_face.get(k).copied().unwrap_or(f64::NAN);
             let ours =
                 self.outcomes.iter().map(|o| o.values.face_to_face.get(k).copied().unwrap_or(f64::NAN)).collect();
-            line(&mut out, pair_key(a, b), self.paper.map(|p| p.face_to_face(a, b)), re, ours, false);
+            rows.push(line(pair_key(a, b), self.paper.map(|p| p.face_to_face(a, b)), re, ours, false));
         }
+        out.push_str(&columns(rows, &widths));
 
         if let Some(rs) = r.face_to_sphere {
             let _ = writeln!(out, "\nFace -> sphere by reciprocity, A_s F_s->f / A_f. Reference: 4 pi R^2 / 216.");
-            header(&mut out, "face");
+            let mut rows = header("face");
             for (f, &re) in rs.iter().enumerate() {
                 let ours = self
                     .outcomes
                     .iter()
                     .map(|o| o.values.face_to_sphere.and_then(|s| s.get(f).copied()).unwrap_or(f64::NAN))
                     .collect();
-                line(&mut out, (f + 1).to_string(), None, re, ours, false);
+                rows.push(line((f + 1).to_string(), None, re, ours, false));
             }
+            out.push_str(&columns(rows, &widths));
         }
 
         let _ = writeln!(
@@ -359,11 +506,12 @@ impl Report {
             "\nTable 4. Sum of each face's factors (other faces{}). Reference: 1.",
             if c.radius > 0.0 { " + sphere" } else { "" }
         );
-        header(&mut out, "face");
+        let mut rows = header("face");
         for (f, &re) in r.face_sum.iter().enumerate() {
             let ours = self.outcomes.iter().map(|o| o.values.face_sum.get(f).copied().unwrap_or(f64::NAN)).collect();
-            line(&mut out, (f + 1).to_string(), self.paper.and_then(|p| p.face_sum(f + 1)), re, ours, true);
+            rows.push(line((f + 1).to_string(), self.paper.and_then(|p| p.face_sum(f + 1)), re, ours, true));
         }
+        out.push_str(&columns(rows, &widths));
 
         let _ = writeln!(
             out,
@@ -373,11 +521,14 @@ impl Report {
             self.threads,
             if self.threads == 1 { "" } else { "s" }
         );
-        let _ = write!(out, "{:<16} {:>24}", "part", "paper (SPARCstation 1+)");
+        let mut widths = vec![(16, CellAlignment::Left), (24, CellAlignment::Right)];
+        let mut rows = vec![vec!["part".to_string(), "paper (SPARCstation 1+)".into()]];
         for o in &self.outcomes {
-            let _ = write!(out, " {:>12}", format!("ours {}", o.precision.name()));
+            widths.push((12, CellAlignment::Right));
+            if let Some(head) = rows.first_mut() {
+                head.push(format!("ours {}", o.precision.name()));
+            }
         }
-        out.push('\n');
         type Getter = fn(&Outcome) -> f64;
         let parts: [(&str, Option<f64>, Getter); 3] = [
             ("sphere -> face", self.paper.map(|p| p.sphere_face_seconds), Outcome::sphere_face_seconds),
@@ -385,14 +536,13 @@ impl Report {
             ("total", self.paper.map(|p| p.sphere_face_seconds + p.face_face_seconds), Outcome::total_seconds),
         ];
         for (name, paper, get) in parts {
-            let p = paper.map_or("-".into(), paper_duration);
-            let _ = write!(out, "{name:<16} {p:>24}");
+            let mut row = vec![name.to_string(), paper.map_or("-".into(), paper_duration)];
             for o in &self.outcomes {
-                let t = if name == "sphere -> face" && c.radius == 0.0 { "-".into() } else { format_seconds(get(o)) };
-                let _ = write!(out, " {t:>12}");
+                row.push(if name == "sphere -> face" && c.radius == 0.0 { "-".into() } else { format_seconds(get(o)) });
             }
-            out.push('\n');
+            rows.push(row);
         }
+        out.push_str(&columns(rows, &widths));
 
         out.push('\n');
         for note in self.notes() {
@@ -476,22 +626,33 @@ impl Report {
     }
 }
 
-/// Wraps a paragraph at 78 columns, continuation lines indented by two spaces.
-fn wrap(text: &str) -> String {
-    let mut out = String::new();
-    let mut line = String::new();
-    for word in text.split_whitespace() {
-        if !line.is_empty() && line.chars().count() + 1 + word.chars().count() > 78 {
-            out.push_str(&line);
-            out.push('\n');
-            line = "  ".into();
-        }
-        if !line.trim().is_empty() {
-            line.push(' ');
-        }
-        line.push_str(word);
+/// Lays out `rows` in columns of at least the given widths (wider if a cell needs it), one
+/// space apart, without borders; one line per row.
+fn columns(rows: Vec<Vec<String>>, widths: &[(u16, CellAlignment)]) -> String {
+    let mut table = Table::new();
+    table.load_style(presets::NOTHING).set_content_arrangement(ContentArrangement::Disabled);
+    for row in rows {
+        table.add_row(row);
     }
-    out.push_str(&line);
+    for (k, (column, &(width, alignment))) in table.column_iter_mut().zip(widths).enumerate() {
+        let gap = u16::from(k > 0);
+        column
+            .set_padding((gap, 0))
+            .set_constraint(ColumnConstraint::LowerBoundary(Width::Fixed(width + gap)))
+            .set_cell_alignment(alignment);
+    }
+    table.lines().map(|l| l + "\n").collect()
+}
+
+/// Wraps a paragraph at 78 columns, continuation lines indented by two spaces; words are never
+/// broken (not at hyphens either).
+fn wrap(text: &str) -> String {
+    let options = textwrap::Options::new(78)
+        .subsequent_indent("  ")
+        .break_words(false)
+        .wrap_algorithm(textwrap::WrapAlgorithm::FirstFit)
+        .word_splitter(textwrap::WordSplitter::NoHyphenation);
+    let mut out = textwrap::fill(text, options);
     out.push('\n');
     out
 }
