@@ -160,6 +160,18 @@ fn edge_pair<T: Real>(rule: &GaussRule<T>, p: Vec3<T>, da: Vec3<T>, q: Vec3<T>, 
     (total.0, total.1, evaluations)
 }
 
+/// (∫ f, ∫ |f|) over [x0, x1] by the rule, f given as x ↦ (f(x), |f(x)|).
+fn rule_on<T: Real>(rule: &GaussRule<T>, x0: T, x1: T, f: &impl Fn(T) -> (T, T)) -> (T, T) {
+    let half = (x1 - x0) * T::HALF;
+    let (mut sum, mut abs) = (T::ZERO, T::ZERO);
+    for (x, w) in rule.points() {
+        let (v, m) = f(x0 + half * (x + T::ONE));
+        sum += w * v;
+        abs += w * m;
+    }
+    (sum * half, abs * half)
+}
+
 /// ∫_lo^hi f with the rule, cut geometrically towards an end whose singularity lies at
 /// parameter distance `d_lo` / `d_hi` (closer than a quarter of the piece).
 fn graded_piece<T: Real>(
@@ -177,14 +189,8 @@ fn graded_piece<T: Real>(
     let mut total = (T::ZERO, T::ZERO);
     let mut evaluations = 0u64;
     let mut piece = |x0: T, x1: T| {
-        let half = (x1 - x0) * T::HALF;
-        let (mut sum, mut abs) = (T::ZERO, T::ZERO);
-        for (x, w) in rule.points() {
-            let (v, m) = f(x0 + half * (x + T::ONE));
-            sum += w * v;
-            abs += w * m;
-        }
-        total = (total.0 + sum * half, total.1 + abs * half);
+        let (sum, abs) = rule_on(rule, x0, x1, f);
+        total = (total.0 + sum, total.1 + abs);
         evaluations = evaluations.saturating_add(rule.order() as u64);
     };
     // From lo upwards: [lo, lo + d], [lo + d, lo + 4d], … while below the middle.
@@ -561,14 +567,8 @@ fn graded_line<T: Real>(
     let mut total = (T::ZERO, T::ZERO);
     let mut evaluations = 0u64;
     let mut piece = |x0: T, x1: T| {
-        let half = (x1 - x0) * T::HALF;
-        let (mut sum, mut abs) = (T::ZERO, T::ZERO);
-        for (x, w) in rule.points() {
-            let (v, m) = f(x0 + half * (x + T::ONE));
-            sum += w * v;
-            abs += w * m;
-        }
-        total = (total.0 + sum * half, total.1 + abs * half);
+        let (sum, abs) = rule_on(rule, x0, x1, f);
+        total = (total.0 + sum, total.1 + abs);
         evaluations = evaluations.saturating_add(rule.order() as u64);
     };
     let floor = (hi - lo) * T::EPSILON;
@@ -1004,40 +1004,46 @@ mod tests {
 
 #[cfg(test)]
 mod point_form_tests {
-    extern crate std;
     use super::*;
     use crate::surface::Disk;
     use crate::vec3::vec3;
-    use std::vec::Vec;
 
-    /// Lambert's polygon form for the unit circle as an m-gon clipped by p's tangent plane.
+    /// Lambert's polygon form for the unit circle as an m-gon clipped by p's tangent plane
+    /// (Sutherland–Hodgman, each clipped vertex summed as it is produced).
     fn polygon(p: Vec3<f64>, np: Vec3<f64>, m: usize) -> f64 {
-        let corners: Vec<Vec3<f64>> = (0..m)
-            .map(|k| {
-                let phi = 2.0 * core::f64::consts::PI * (k as f64) / m as f64;
-                vec3(phi.cos(), phi.sin(), 0.0)
-            })
-            .collect();
-        let mut clipped = Vec::new();
-        for (i, &a) in corners.iter().enumerate() {
-            let b = corners[(i + 1) % m];
+        let corner = |k: usize| {
+            let phi = 2.0 * core::f64::consts::PI * ((k % m) as f64) / m as f64;
+            vec3(phi.cos(), phi.sin(), 0.0)
+        };
+        // The polygon's edges as its vertices come: (sum, first vertex, previous vertex).
+        let mut state = (0.0, None::<Vec3<f64>>, None::<Vec3<f64>>);
+        let add = |state: &mut (f64, Option<Vec3<f64>>, Option<Vec3<f64>>), v: Vec3<f64>| {
+            if let Some(u) = state.2 {
+                let (a, b) = (u - p, v - p);
+                let c = a.cross(b);
+                let sine = c.norm();
+                if sine > 0.0 {
+                    state.0 += sine.atan2(a.dot(b)) * np.dot(c) / sine;
+                }
+            } else {
+                state.1 = Some(v);
+            }
+            state.2 = Some(v);
+        };
+        for k in 0..m {
+            let (a, b) = (corner(k), corner(k + 1));
             let (da, db) = (np.dot(a - p), np.dot(b - p));
             if da > 0.0 {
-                clipped.push(a);
+                add(&mut state, a);
             }
             if (da > 0.0) != (db > 0.0) {
-                clipped.push(a + (b - a).scale(da / (da - db)));
+                add(&mut state, a + (b - a).scale(da / (da - db)));
             }
         }
-        let mut sum = 0.0;
-        for i in 0..clipped.len() {
-            let (a, b) = (clipped[i] - p, clipped[(i + 1) % clipped.len()] - p);
-            let c = a.cross(b);
-            let sine = c.norm();
-            if sine > 0.0 {
-                sum += sine.atan2(a.dot(b)) * np.dot(c) / sine;
-            }
+        if let Some(v) = state.1 {
+            add(&mut state, v);
         }
+        let sum = state.0;
         0.5 * sum.abs()
     }
 
