@@ -50,10 +50,10 @@ fn bench_pairs(c: &mut Criterion) {
     let mut group = c.benchmark_group("pair");
     for order in [8, 12, 16] {
         let s = settings(order);
-        let contour = pair_exchange::<f64, _, _, _, 256>(&pf, &pw, s, &()).unwrap();
+        let contour = pair_exchange::<f64, _, _, _, 256>(&pf, &pw, s, &()).unwrap().value;
         let transform = touching_exchange(&pf, &pw, adjacency, gap, order, &()).unwrap();
-        let parallel = pair_exchange::<f64, _, _, _, 256>(&pf, &pt, s, &()).unwrap();
-        let coaxial = pair_exchange::<f64, _, _, _, 256>(&pl, &pu, s, &()).unwrap();
+        let parallel = pair_exchange::<f64, _, _, _, 256>(&pf, &pt, s, &()).unwrap().value;
+        let coaxial = pair_exchange::<f64, _, _, _, 256>(&pl, &pu, s, &()).unwrap().value;
         eprintln!(
             "order {order}: c14 contour {:.1e}, c14 edge transform {:.1e}, c11 {:.1e}, c41 disks at 0.01 {:.1e}",
             (contour - C14).abs() / C14,
@@ -62,16 +62,16 @@ fn bench_pairs(c: &mut Criterion) {
             (coaxial - disks).abs() / disks
         );
         group.bench_with_input(BenchmarkId::new("c14/contour", order), &order, |bench, _| {
-            bench.iter(|| pair_exchange::<f64, _, _, _, 256>(black_box(&pf), black_box(&pw), s, &()).unwrap());
+            bench.iter(|| pair_exchange::<f64, _, _, _, 256>(black_box(&pf), black_box(&pw), s, &()).unwrap().value);
         });
         group.bench_with_input(BenchmarkId::new("c14/edge-transform", order), &order, |bench, _| {
             bench.iter(|| touching_exchange(black_box(&pf), black_box(&pw), adjacency, gap, order, &()).unwrap());
         });
         group.bench_with_input(BenchmarkId::new("c11/contour", order), &order, |bench, _| {
-            bench.iter(|| pair_exchange::<f64, _, _, _, 256>(black_box(&pf), black_box(&pt), s, &()).unwrap());
+            bench.iter(|| pair_exchange::<f64, _, _, _, 256>(black_box(&pf), black_box(&pt), s, &()).unwrap().value);
         });
         group.bench_with_input(BenchmarkId::new("c41-0.01/contour", order), &order, |bench, _| {
-            bench.iter(|| pair_exchange::<f64, _, _, _, 256>(black_box(&pl), black_box(&pu), s, &()).unwrap());
+            bench.iter(|| pair_exchange::<f64, _, _, _, 256>(black_box(&pl), black_box(&pu), s, &()).unwrap().value);
         });
     }
     group.finish();
@@ -89,23 +89,23 @@ fn near_flat(c: &mut Criterion) {
     let wall = Cylinder::new(vec3(0.0, 0.0, 0.1), up, 1.0, 1.0, Side::Inner).unwrap();
     let (pd, pw) = (Patch::whole(&disk).unwrap(), Patch::whole(&wall).unwrap());
     let disk_wall = std::f64::consts::PI * (coaxial_disks(1.0, 1.0, 0.1) - coaxial_disks(1.0, 1.0, 1.1));
-    let wall_24 = pair_exchange::<f64, _, _, _, 625>(&ph, &pb, settings(24), &()).unwrap();
+    let wall_24 = pair_exchange::<f64, _, _, _, 625>(&ph, &pb, settings(24), &()).unwrap().value;
     let mut group = c.benchmark_group("pair");
     group.sample_size(10);
     for order in [12, 16] {
         let s = PairSettings { order, singular_order: 12, boundaries: true };
-        let w = pair_exchange::<f64, _, _, _, 256>(&ph, &pb, s, &()).unwrap();
-        let d = pair_exchange::<f64, _, _, _, 256>(&pd, &pw, s, &()).unwrap();
+        let w = pair_exchange::<f64, _, _, _, 256>(&ph, &pb, s, &()).unwrap().value;
+        let d = pair_exchange::<f64, _, _, _, 256>(&pd, &pw, s, &()).unwrap().value;
         eprintln!(
             "order {order}: half wall 0.1 above a floor {:.1e} (against order 24), disk 0.1 below a wall {:.1e}",
             (w - wall_24).abs() / wall_24,
             (d - disk_wall).abs() / disk_wall
         );
         group.bench_with_input(BenchmarkId::new("half-wall-0.1", order), &order, |bench, _| {
-            bench.iter(|| pair_exchange::<f64, _, _, _, 256>(black_box(&ph), black_box(&pb), s, &()).unwrap());
+            bench.iter(|| pair_exchange::<f64, _, _, _, 256>(black_box(&ph), black_box(&pb), s, &()).unwrap().value);
         });
         group.bench_with_input(BenchmarkId::new("disk-wall-0.1", order), &order, |bench, _| {
-            bench.iter(|| pair_exchange::<f64, _, _, _, 256>(black_box(&pd), black_box(&pw), s, &()).unwrap());
+            bench.iter(|| pair_exchange::<f64, _, _, _, 256>(black_box(&pd), black_box(&pw), s, &()).unwrap().value);
         });
     }
     group.finish();

@@ -468,7 +468,7 @@ fn pair_sum<T: Real>(
     let mut sum = 0.0;
     for a in pa {
         for b in pb {
-            sum += pair_exchange::<T, _, _, _, CAP>(a, b, PairSettings::ACCURATE, occ)?.to_f64();
+            sum += pair_exchange::<T, _, _, _, CAP>(a, b, PairSettings::ACCURATE, occ)?.value.to_f64();
         }
     }
     Ok(sum)
@@ -485,7 +485,7 @@ fn adaptive_sum<T: Real>(
         for b in pb {
             let e = adaptive_exchange::<T, _, _, _, CAP>(a, b, Adaptive::new(T::from_f64(tol)), occ)?;
             s.value += e.value.to_f64();
-            s.error += e.error.to_f64();
+            s.error += e.error.map_or(f64::INFINITY, Real::to_f64);
         }
     }
     Ok(s)

@@ -232,7 +232,7 @@ fn bad_input_is_one_line_naming_the_value() {
         (&["--repeat", "1001"], "1001"),
         (&["--threads", "-1"], "-1"),
         (&["--threads", "5000"], "5000"),
-        // Paper mode keeps every patch's samples: 3.8 GiB here.
+        // Paper mode at 7e12 kernel evaluations: hours.
         (&["--sphere-grid", "256x256", "--order", "32"], "256x256"),
         (&["--mode", "paper", "--tolerance", "1e-6"], "tolerance"),
         (&["--bogus"], "--bogus"),

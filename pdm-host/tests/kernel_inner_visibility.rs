@@ -100,7 +100,7 @@ fn adaptive_estimates_across_the_sphere_shadow() {
         let b = Patch::whole(&fb).unwrap();
         for tol in [1e-3, 1e-5, 1e-7] {
             let e = adaptive_exchange::<f64, _, _, _, 256>(&a, &b, Adaptive::new(tol), &sphere).unwrap();
-            let (value, estimate) = (e.value / 36.0, e.error / 36.0);
+            let (value, estimate) = (e.value / 36.0, e.error.unwrap() / 36.0);
             let actual = (value - exact).abs();
             println!(
                 "face 1 -> {face_b}, tol {tol:e}: F = {value:.12}, actual {:.2e}, estimate {:.2e}, {} evaluations",

@@ -127,9 +127,9 @@ fn workload<T: Real, const CAP: usize>(entry: Entry, depth: u32) {
             Quadrature::uniform(order),
             &sphere,
         ),
-        Entry::PairEdge => pair_exchange::<T, _, _, _, CAP>(&q1, &q2, settings, &sphere),
-        Entry::PairShadow => pair_exchange::<T, _, _, _, CAP>(&w1, &w6, settings, &sphere),
-        Entry::PairCurved => pair_exchange::<T, _, _, _, CAP>(&cell, &w1, settings, &()),
+        Entry::PairEdge => pair_exchange::<T, _, _, _, CAP>(&q1, &q2, settings, &sphere).map(|e| e.value),
+        Entry::PairShadow => pair_exchange::<T, _, _, _, CAP>(&w1, &w6, settings, &sphere).map(|e| e.value),
+        Entry::PairCurved => pair_exchange::<T, _, _, _, CAP>(&cell, &w1, settings, &()).map(|e| e.value),
         Entry::AdaptiveEdge => adaptive_exchange::<T, _, _, _, CAP>(&q1, &q2, adaptive, &sphere).map(|e| e.value),
         Entry::AdaptiveShadow => adaptive_exchange::<T, _, _, _, CAP>(&w1, &w6, adaptive, &sphere).map(|e| e.value),
     };

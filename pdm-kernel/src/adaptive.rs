@@ -83,6 +83,7 @@
 //! (`Err(CapacityExceeded)` otherwise, also checked first).
 
 use crate::error::PdmError;
+use crate::estimate::Estimate;
 use crate::form_factor::exchange_unchecked;
 use crate::integrand::mutually_facing;
 use crate::patch::Patch;
@@ -149,24 +150,18 @@ impl<T: Real> Adaptive<T> {
     }
 }
 
-/// A value with its error estimate, whether the estimate met the tolerance, and its cost.
+/// A partial result inside the tolerance mode: a value, its error estimate (always present),
+/// whether it met the tolerance, and its cost. [`adaptive_exchange`] returns it as an
+/// [`Tally`] with `error: Some(_)`.
 #[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct Estimate<T> {
-    /// The value (A_a·F_{a→b} for [`adaptive_exchange`]).
-    pub value: T,
-    /// Estimated absolute error of `value` (the sum over the leaf pairs; see the module docs).
-    pub error: T,
-    /// `true` only if every leaf pair's estimate is ≤ tolerance·|value| (or both are zero), so
-    /// that `error` ≤ tolerance·`value`. `false` when the depth limit or the precision floor
-    /// stopped the refinement first: `value` is then the best the settings allow, `error` its
-    /// estimate, above the tolerance.
-    pub converged: bool,
-    /// Integrand evaluations spent (kernel evaluations and visibility probes).
-    pub evaluations: u64,
+struct Tally<T> {
+    value: T,
+    error: T,
+    converged: bool,
+    evaluations: u64,
 }
 
-impl<T: Real> Estimate<T> {
+impl<T: Real> Tally<T> {
     /// A leaf's estimate: `difference` (already scaled) plus the rounding allowance; converged
     /// if within `tol`.
     fn leaf(value: T, difference: T, tol: T, evaluations: u64) -> Self {
@@ -201,8 +196,9 @@ impl<T: Real> Estimate<T> {
 /// let (a, b) = (Patch::whole(&floor)?, Patch::whole(&ceiling)?);
 /// let e = adaptive_exchange::<f64, _, _, _, 144>(&a, &b, Adaptive::new(1e-8), &())?;
 /// assert!(e.converged, "check it: false means the tolerance was not met");
-/// assert!(e.error <= 1e-8 * e.value);
-/// assert!((e.value - 0.1998248956983874).abs() <= e.error); // A_a = 1
+/// let error = e.error.expect("the tolerance mode always estimates its error");
+/// assert!(error <= 1e-8 * e.value);
+/// assert!((e.value - 0.1998248956983874).abs() <= error); // A_a = 1
 /// # Ok::<(), pdm_kernel::PdmError>(())
 /// ```
 pub fn adaptive_exchange<T, SA, SB, O, const CAP: usize>(
@@ -229,7 +225,7 @@ where
     let floor = T::from_f64(PRECISION_FLOOR) * T::EPSILON;
     let work = Adaptive { tolerance: settings.tolerance.max(floor), ..settings };
     // Closed patches are cut at their seams first, as in `pair_exchange`.
-    let mut e = Estimate::zero(0);
+    let mut e = Tally::zero(0);
     crate::pair::for_each_piece_pair(a, b, |pa, pb| {
         e.add(recurse::<T, SA, SB, O, CAP>(pa, pb, work, occluders, 0)?);
         Ok(())
@@ -243,7 +239,7 @@ where
     // far from the other's rim): the sum of the estimates bounds the total's error.
     e.converged |= e.error <= work.tolerance * e.value.abs();
     e.converged &= work.tolerance == settings.tolerance || e.error <= settings.tolerance * e.value.abs();
-    Ok(e)
+    Ok(Estimate { value: e.value, error: Some(e.error), converged: e.converged, evaluations: e.evaluations })
 }
 
 fn recurse<T, SA, SB, O, const CAP: usize>(
@@ -252,7 +248,7 @@ fn recurse<T, SA, SB, O, const CAP: usize>(
     settings: Adaptive<T>,
     occluders: &O,
     depth: u32,
-) -> Result<Estimate<T>, PdmError>
+) -> Result<Tally<T>, PdmError>
 where
     T: Real,
     SA: Surface<T> + ?Sized,
@@ -316,7 +312,7 @@ fn contour_leaf<T, SA, SB, O>(
     lo_order: usize,
     settings: Adaptive<T>,
     occluders: &O,
-) -> Option<Result<(Estimate<T>, bool), PdmError>>
+) -> Option<Result<(Tally<T>, bool), PdmError>>
 where
     T: Real,
     SA: Surface<T> + ?Sized,
@@ -334,7 +330,7 @@ where
             Err(e) => return Some(Err(e)),
         };
         evaluations = evaluations.saturating_add(n);
-        let estimate = Estimate::leaf(hi, (hi - lo).abs() + rounding, settings.tolerance, evaluations);
+        let estimate = Tally::leaf(hi, (hi - lo).abs() + rounding, settings.tolerance, evaluations);
         if estimate.converged || order >= crate::gauss::MAX_ORDER {
             return Some(Ok((estimate, crate::bounds::lost_digits(hi, rounding))));
         }
@@ -357,7 +353,7 @@ fn identical<T, S, O, const CAP: usize>(
     settings: Adaptive<T>,
     occluders: &O,
     depth: u32,
-) -> Result<Estimate<T>, PdmError>
+) -> Result<Tally<T>, PdmError>
 where
     T: Real,
     S: Surface<T> + ?Sized,
@@ -385,7 +381,7 @@ fn collapsed_contact<T, SA, SB, O>(
     gap: T,
     settings: Adaptive<T>,
     occluders: &O,
-) -> Result<Estimate<T>, PdmError>
+) -> Result<Tally<T>, PdmError>
 where
     T: Real,
     SA: Surface<T> + ?Sized,
@@ -406,7 +402,7 @@ where
 fn algebraic_leaf<T: Real>(
     eval: impl Fn(usize) -> Result<(T, u64), PdmError>,
     settings: Adaptive<T>,
-) -> Result<Estimate<T>, PdmError> {
+) -> Result<Tally<T>, PdmError> {
     let p = settings.max_order;
     let (hi, mut evaluations) = eval(p)?;
     let mut difference = T::ZERO;
@@ -415,7 +411,7 @@ fn algebraic_leaf<T: Real>(
         difference = difference.max((hi - v).abs());
         evaluations = evaluations.saturating_add(n);
     }
-    Ok(Estimate::leaf(hi, T::from_f64(SAFETY) * difference, settings.tolerance, evaluations))
+    Ok(Tally::leaf(hi, T::from_f64(SAFETY) * difference, settings.tolerance, evaluations))
 }
 
 /// The starting order of a separate pair from its geometry (module docs, item 2), capped at
@@ -489,7 +485,7 @@ fn separate<T, SA, SB, O, const CAP: usize>(
     settings: Adaptive<T>,
     occluders: &O,
     depth: u32,
-) -> Result<Estimate<T>, PdmError>
+) -> Result<Tally<T>, PdmError>
 where
     T: Real,
     SA: Surface<T> + ?Sized,
@@ -546,7 +542,7 @@ fn by_order_doubling<T, SA, SB, O, const CAP: usize>(
     eval: impl Fn(usize) -> Result<(T, u64), PdmError>,
     first_order: usize,
     how: Split,
-) -> Result<Estimate<T>, PdmError>
+) -> Result<Tally<T>, PdmError>
 where
     T: Real,
     SA: Surface<T> + ?Sized,
@@ -563,10 +559,10 @@ where
         evaluations = evaluations.saturating_add(n);
         let difference = (next - prev).abs();
         let estimate = previous_difference.map_or(difference, |d1| difference.max((d1 * difference).sqrt()));
-        let leaf = Estimate::leaf(next, estimate, settings.tolerance, evaluations);
+        let leaf = Tally::leaf(next, estimate, settings.tolerance, evaluations);
         let accepted = leaf.converged && (how == Split::Larger || previous_difference.is_some());
         if accepted || (next_p + 2 > last_order && depth >= settings.max_depth) {
-            return Ok(Estimate { converged: accepted, ..leaf });
+            return Ok(Tally { converged: accepted, ..leaf });
         }
         if next_p + 2 > last_order {
             let children = match how {
@@ -589,7 +585,7 @@ fn across_leaf<T, SA, SB, O, const CAP: usize>(
     b: &Patch<'_, T, SB>,
     settings: Adaptive<T>,
     occluders: &O,
-) -> Result<Estimate<T>, PdmError>
+) -> Result<Tally<T>, PdmError>
 where
     T: Real,
     SA: Surface<T> + ?Sized,
@@ -622,7 +618,7 @@ where
     let difference = [best - whole, best - whole_next, best - quarters, quarters - whole, quarters - whole_next]
         .iter()
         .fold(T::ZERO, |m, d| m.max(d.abs()));
-    Ok(Estimate::leaf(best, T::from_f64(SAFETY) * difference, settings.tolerance, evaluations))
+    Ok(Tally::leaf(best, T::from_f64(SAFETY) * difference, settings.tolerance, evaluations))
 }
 
 /// A pair that a visibility boundary crosses. The boundaries are placed into the inner rule
@@ -636,7 +632,7 @@ fn across_boundaries<T, SA, SB, O, const CAP: usize>(
     settings: Adaptive<T>,
     occluders: &O,
     depth: u32,
-) -> Result<Estimate<T>, PdmError>
+) -> Result<Tally<T>, PdmError>
 where
     T: Real,
     SA: Surface<T> + ?Sized,
@@ -654,9 +650,9 @@ where
 /// below the geometry's resolution: `Err(Degenerate)` or `Err(Unresolvable)` from a child) —
 /// the parent's value with its estimate, `converged = false`: that estimate was computed
 /// before the split and was above the tolerance, which is what the result then says.
-fn or_parent<T: Real>(children: Result<Estimate<T>, PdmError>, parent: Estimate<T>) -> Result<Estimate<T>, PdmError> {
+fn or_parent<T: Real>(children: Result<Tally<T>, PdmError>, parent: Tally<T>) -> Result<Tally<T>, PdmError> {
     match children {
-        Err(PdmError::Degenerate | PdmError::Unresolvable) => Ok(Estimate { converged: false, ..parent }),
+        Err(PdmError::Degenerate | PdmError::Unresolvable) => Ok(Tally { converged: false, ..parent }),
         other => other,
     }
 }
@@ -671,14 +667,14 @@ fn split_both<T, SA, SB, O, const CAP: usize>(
     occluders: &O,
     depth: u32,
     spent: u64,
-) -> Result<Estimate<T>, PdmError>
+) -> Result<Tally<T>, PdmError>
 where
     T: Real,
     SA: Surface<T> + ?Sized,
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
-    let mut total = Estimate::zero(spent);
+    let mut total = Tally::zero(spent);
     let (ra, rb) = (a.rect(), b.rect());
     for k in 0..4 {
         let ca = Patch::new(a.surface(), ra.cell(k / 2, k % 2, 2, 2))?;
@@ -699,14 +695,14 @@ fn split<T, SA, SB, O, const CAP: usize>(
     occluders: &O,
     depth: u32,
     spent: u64,
-) -> Result<Estimate<T>, PdmError>
+) -> Result<Tally<T>, PdmError>
 where
     T: Real,
     SA: Surface<T> + ?Sized,
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
-    let mut total = Estimate::zero(spent);
+    let mut total = Tally::zero(spent);
     let (la, lb) = (side_lengths(a), side_lengths(b));
     let split_a = la.0.max(la.1) >= lb.0.max(lb.1);
     for half in 0..2 {

@@ -104,29 +104,14 @@ where
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
-    boundary_exchange_counted::<T, SA, SB, O, CAP>(a, b, order, occluders).map(|(v, _)| v)
+    let (value, _, area_a, area_b) = boundary_unchecked::<T, SA, SB, O, CAP>(a, b, order, occluders)?;
+    crate::bounds::exchange(value, area_a, area_b)
 }
 
-/// [`boundary_exchange`] and the number of integrand evaluations it made (kernel evaluations
-/// plus visibility probes, each of which evaluates the surface and the visibility tests).
-pub fn boundary_exchange_counted<T, SA, SB, O, const CAP: usize>(
-    a: &Patch<'_, T, SA>,
-    b: &Patch<'_, T, SB>,
-    order: usize,
-    occluders: &O,
-) -> Result<(T, u64), PdmError>
-where
-    T: Real,
-    SA: Surface<T> + ?Sized,
-    SB: Surface<T> + ?Sized,
-    O: Occluder<T> + ?Sized,
-{
-    let (value, count, area_a, area_b) = boundary_unchecked::<T, SA, SB, O, CAP>(a, b, order, occluders)?;
-    Ok((crate::bounds::exchange(value, area_a, area_b)?, count))
-}
-
-/// [`boundary_exchange_counted`] without the bounds check (finite only; see
-/// `bounds::finite`), with the two patches' areas at `order`.
+/// [`boundary_exchange`] without the bounds check (finite only; see `bounds::finite`), with
+/// the number of integrand evaluations it made (kernel evaluations plus visibility probes,
+/// each of which evaluates the surface and the visibility tests) and the two patches' areas
+/// at `order`.
 pub(crate) fn boundary_unchecked<T, SA, SB, O, const CAP: usize>(
     a: &Patch<'_, T, SA>,
     b: &Patch<'_, T, SB>,

@@ -76,6 +76,7 @@ pub(crate) fn form_factor<T: Real>(value: T) -> Result<T, PdmError> {
 /// Whether a value was summed from terms over a thousand times larger: its rounding bound
 /// (8 ε × the terms' magnitude) above 8000 ε of it. The quadrature error of the terms is then
 /// amplified as much (the contour form on flat patches side by side, nearly in one plane).
+#[cfg(feature = "closed-form")]
 pub(crate) fn cancels<T: Real>(value: T, rounding: T) -> bool {
     rounding > T::from_f64(8000.0) * T::EPSILON * value.abs()
 }

@@ -1,5 +1,5 @@
-//! The PDM sum: form factors between patches, eqs. (15)–(16), and between subdivided surfaces by
-//! substructuring, eqs. (25)–(26).
+//! The PDM sum: form factors between patches, eqs. (15)–(16) (between subdivided surfaces by
+//! substructuring, eqs. (25)–(26): `substructure.rs`).
 //!
 //! Eq. (15) gives F_{1→2} = 1/(π A₁) ∫∫∫∫ (n₁·e₁₂)(n₂·e₂₁)/L⁴ ds dt dφ dθ with unnormalised
 //! normals. Eq. (16) writes its Gauss sum but omits the 1/π and the interval Jacobians (it is
@@ -22,6 +22,7 @@
 //! visibility boundary (terminator or shadow edge inside a patch).
 
 use crate::error::PdmError;
+use crate::estimate::Estimate;
 use crate::gauss::GaussRule;
 use crate::integrand;
 use crate::patch::{Patch, PatchGrid};
@@ -151,7 +152,7 @@ where
     let rule_a = GaussRule::<T>::new(quadrature.order_a)?;
     let rule_b = GaussRule::<T>::new(quadrature.order_b)?;
     let (exchange, area) = resolved_exchange::<T, SA, SB, O, CAP>(a, b, &rule_a, &rule_b, occluders)?;
-    crate::bounds::form_factor(exchange / area)
+    crate::bounds::form_factor(exchange.value / area)
 }
 
 /// Node spacings (the larger patch's sample diameter over its order) below which two patches
@@ -160,14 +161,15 @@ where
 pub const RESOLVED_DISTANCE: usize = 2;
 
 /// A_a·F_{a→b} by the PDM sum where it resolves the pair, else by [`crate::pair_exchange`] at
-/// the same order (see [`form_factor_between`]); and A_a from a's samples.
-fn resolved_exchange<T, SA, SB, O, const CAP: usize>(
+/// the same order (see [`form_factor_between`]), with its evaluations; and A_a from a's
+/// samples.
+pub(crate) fn resolved_exchange<T, SA, SB, O, const CAP: usize>(
     a: &Patch<'_, T, SA>,
     b: &Patch<'_, T, SB>,
     rule_a: &GaussRule<T>,
     rule_b: &GaussRule<T>,
     occluders: &O,
-) -> Result<(T, T), PdmError>
+) -> Result<(Estimate<T>, T), PdmError>
 where
     T: Real,
     SA: Surface<T> + ?Sized,
@@ -176,7 +178,8 @@ where
 {
     let (plain, area) = plain_if_resolved::<T, SA, SB, O, CAP>(a, b, rule_a, rule_b, occluders)?;
     if let Some(e) = plain {
-        return Ok((e, area));
+        let points = |rule: &GaussRule<T>| (rule.order() * rule.order()) as u64;
+        return Ok((Estimate::fixed(e, points(rule_a).saturating_mul(points(rule_b))), area));
     }
     let order = rule_a.order().max(rule_b.order()).max(2);
     let settings = crate::pair::PairSettings { order, singular_order: order, boundaries: true };
@@ -277,13 +280,13 @@ where
     Ok((exchange_unchecked(&a, &b, occluders)?, (a.area() + b.area()) * T::HALF))
 }
 
-/// Substructuring, eqs. (25)–(26): F_{A→B} = (1/A_A) Σ_{pa} Σ_{pb} A_pa F_{pa→pb} between the
-/// patches of grid `a` and grid `b`, each patch pair as by [`form_factor_between`] (the PDM sum,
-/// or [`crate::pair_exchange`] on the pairs the sum cannot resolve: adjacent and identical
-/// patches, patches closer than [`RESOLVED_DISTANCE`] spacings). A_A is the sum of the patch
-/// areas by eq. (12) with the same rule (so that a surface's factors to a closed enclosure sum
-/// to 1 up to the quadrature error). Every patch is re-sampled for each pair; nothing is
-/// allocated.
+/// F_{A→B} between the patches of grid `a` and grid `b` by substructuring
+/// ([`crate::surface_exchange`] with [`crate::Method::Plain`]): each patch pair as by
+/// [`form_factor_between`] (the PDM sum, or [`crate::pair_exchange`] on the pairs the sum cannot
+/// resolve: adjacent and identical patches, patches closer than [`RESOLVED_DISTANCE`]
+/// spacings), divided by A_A, the sum of the patch areas by eq. (12) with the same rule's
+/// weights (so that a surface's factors to a closed enclosure sum to 1 up to the quadrature
+/// error). Every patch is re-sampled for each pair; nothing is allocated.
 pub fn surface_form_factor<T, SA, SB, O, const CAP: usize>(
     a: PatchGrid<'_, T, SA>,
     b: PatchGrid<'_, T, SB>,
@@ -298,18 +301,8 @@ where
 {
     let rule_a = GaussRule::<T>::new(quadrature.order_a)?;
     let rule_b = GaussRule::<T>::new(quadrature.order_b)?;
-    let mut total_area = T::ZERO;
-    let mut total_exchange = T::ZERO;
-    for pa in a {
-        let mut area = T::ZERO;
-        for pb in b.clone() {
-            let (e, area_a) = resolved_exchange::<T, SA, SB, O, CAP>(&pa, &pb, &rule_a, &rule_b, occluders)?;
-            total_exchange += e;
-            area = area_a;
-        }
-        total_area += area;
-    }
-    crate::bounds::form_factor(total_exchange / total_area)
+    let (total, area) = crate::substructure::plain_total::<T, SA, SB, O, CAP>(a, b, &rule_a, &rule_b, occluders)?;
+    crate::bounds::form_factor(total.value / area)
 }
 
 /// Σ_k w_k Σ_l w_l (n̂_k·e / L²)(−n̂_l·e / L²) over mutually facing, unoccluded pairs.

@@ -39,9 +39,14 @@
 //! Debug builds need about 3.7× these. Give a thread that runs the tolerance mode at a large
 //! capacity a stack to match (`std::thread::Builder::stack_size`); the `pdm-ff` command does.
 //!
+//! **Start with the [`guide`]**: one pair of patches, curved surfaces and occluders, subdivided
+//! surfaces, the tolerance mode and the sample capacity, each with a runnable example.
+//!
 //! Modules: [`gauss`] (tables), [`surface`] (surfaces and normals), [`patch`] (patches, grids,
 //! areas), [`samples`] (precomputed Gauss samples), [`visibility`] (curvature and occlusion
-//! tests), [`form_factor`](mod@form_factor) (the PDM sum and substructuring).
+//! tests), [`form_factor`](mod@form_factor) (the PDM sum), [`pair`] (the method each pair
+//! needs), [`adaptive`] (the tolerance mode), [`substructure`] (subdivided surfaces, every
+//! method).
 
 #![no_std]
 #![forbid(unsafe_code)]
@@ -64,9 +69,11 @@ mod bounds;
 mod contour;
 pub mod dual;
 pub mod error;
+mod estimate;
 pub mod fixed;
 pub mod form_factor;
 pub mod gauss;
+pub mod guide;
 mod integrand;
 mod math;
 pub mod pair;
@@ -74,6 +81,7 @@ pub mod patch;
 pub mod real;
 pub mod samples;
 mod singular;
+pub mod substructure;
 pub mod surface;
 pub mod vec3;
 pub mod visibility;
@@ -83,15 +91,17 @@ pub mod visibility;
 #[doc = include_str!("../README.md")]
 struct ReadmeDoctests;
 
-pub use adaptive::{adaptive_exchange, Adaptive, Estimate};
+pub use adaptive::{adaptive_exchange, Adaptive};
 pub use dual::{Dual, Scalar};
 pub use error::PdmError;
+pub use estimate::Estimate;
 pub use form_factor::{exchange, form_factor, form_factor_between, self_form_factor, surface_form_factor, Quadrature};
 pub use gauss::{GaussRule, MAX_ORDER};
 pub use pair::{pair_exchange, PairSettings};
 pub use patch::{Patch, PatchGrid};
 pub use real::Real;
 pub use samples::{Ball, PatchSamples, Sample};
+pub use substructure::{surface_exchange, with_capacity, Method, WithCapacity, CAPACITIES};
 pub use surface::{
     AutoNormal, BezierPatch, Cone, Cylinder, Disk, Flipped, Frame, Parallelogram, ParamRect, ParametricMap, Side,
     Sphere, Surface,
@@ -104,7 +114,7 @@ pub use visibility::{mutually_facing, AnyOccluder, Occluder};
 /// evaluation counts, internal limits). Not part of the API: no semver promise, no docs.
 #[doc(hidden)]
 pub mod internals {
-    pub use crate::boundary::{boundary_exchange, boundary_exchange_counted, MAX_BREAKS, MAX_NEAR_DEPTH, MAX_SPLITS};
-    pub use crate::pair::{pair_exchange_counted, MAX_CONTACT_SPLITS, OCCLUDED_OUTER_SPLIT};
+    pub use crate::boundary::{boundary_exchange, MAX_BREAKS, MAX_NEAR_DEPTH, MAX_SPLITS};
+    pub use crate::pair::{MAX_CONTACT_SPLITS, OCCLUDED_OUTER_SPLIT};
     pub use crate::singular::{classify, classify_near, touching_exchange, Adjacency, SquareMap, NEAR_CONTACT};
 }

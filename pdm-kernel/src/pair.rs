@@ -38,6 +38,7 @@
 use crate::adaptive::straddles_curvature_cut;
 use crate::boundary::boundary_unchecked;
 use crate::error::PdmError;
+use crate::estimate::Estimate;
 use crate::form_factor::exchange_unchecked;
 use crate::integrand::mutually_facing;
 use crate::patch::Patch;
@@ -79,7 +80,12 @@ impl PairSettings {
     pub const ACCURATE: Self = Self { order: 16, singular_order: 12, boundaries: true };
 }
 
-/// A_a·F_{a→b} for any two patches, by the method the pair needs (see the module docs).
+/// A_a·F_{a→b} for any two patches, by the method the pair needs (see the module docs), as an
+/// [`Estimate`] without an error estimate (`error: None`, `converged: false`: a fixed-order
+/// method) and with the work it did in `evaluations`: kernel evaluations and visibility probes
+/// on the boundary path (`boundary.rs`), order⁴ for a plain sum and order⁴ more for the
+/// straddle check, 6·p⁴ for a shared edge and 4·p⁴ for a shared vertex (p = `singular_order`),
+/// 4·p⁴ for a self pair (times the ζ-shells of long patches).
 ///
 /// The quantity is symmetric (A_a·F_{a→b} = A_b·F_{b→a}), and so, mostly, is the computation:
 /// on the boundary path one patch is integrated outside (its Gauss points) and the other inside
@@ -138,9 +144,10 @@ impl PairSettings {
 /// // Two perpendicular unit squares sharing an edge (catalogue C-14: F = 0.2000437760754...).
 /// let floor = Parallelogram::new(vec3(0.0, 0.0, 0.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0))?;
 /// let wall = Parallelogram::new(vec3(0.0, 0.0, 0.0), vec3(0.0, 0.0, 1.0), vec3(1.0, 0.0, 0.0))?;
-/// let f = pair_exchange::<f64, _, _, _, 256>(
+/// let e = pair_exchange::<f64, _, _, _, 256>(
 ///     &Patch::whole(&floor)?, &Patch::whole(&wall)?, PairSettings::ACCURATE, &())?;
-/// assert!((f - 0.20004377607540316).abs() < 1e-12);
+/// assert!((e.value - 0.20004377607540316).abs() < 1e-12); // A_floor = 1
+/// assert_eq!(e.error, None); // a fixed-order method: no estimate (see `adaptive_exchange`)
 /// # Ok::<(), pdm_kernel::PdmError>(())
 /// ```
 pub fn pair_exchange<T, SA, SB, O, const CAP: usize>(
@@ -148,27 +155,7 @@ pub fn pair_exchange<T, SA, SB, O, const CAP: usize>(
     b: &Patch<'_, T, SB>,
     settings: PairSettings,
     occluders: &O,
-) -> Result<T, PdmError>
-where
-    T: Real,
-    SA: Surface<T> + ?Sized,
-    SB: Surface<T> + ?Sized,
-    O: Occluder<T> + ?Sized,
-{
-    pair_exchange_counted::<T, SA, SB, O, CAP>(a, b, settings, occluders).map(|(value, _)| value)
-}
-
-/// [`pair_exchange`] and the work it did, in integrand evaluations: kernel evaluations and
-/// visibility probes on the boundary path (`boundary.rs`), order⁴ for a
-/// plain sum and order⁴ more for the straddle check, 6·p⁴ for a shared edge and 4·p⁴ for a
-/// shared vertex (p = `singular_order`), 4·p⁴ for a self pair (times the ζ-shells of long patches).
-#[doc(hidden)]
-pub fn pair_exchange_counted<T, SA, SB, O, const CAP: usize>(
-    a: &Patch<'_, T, SA>,
-    b: &Patch<'_, T, SB>,
-    settings: PairSettings,
-    occluders: &O,
-) -> Result<(T, u64), PdmError>
+) -> Result<Estimate<T>, PdmError>
 where
     T: Real,
     SA: Surface<T> + ?Sized,
@@ -196,7 +183,7 @@ where
     // pair and the value is refused.
     let band = value.abs() * T::from_f64(QUADRATURE_BAND);
     let value = crate::bounds::exchange_within(value, band, a.area(order)?, b.area(order)?)?;
-    Ok((value, count))
+    Ok(Estimate::fixed(value, count))
 }
 
 /// `true` if two patches are closer than the larger one's radius: the plain rule's error then

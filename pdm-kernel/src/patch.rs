@@ -165,6 +165,16 @@ impl<'s, T: Real, S: Surface<T> + ?Sized> PatchGrid<'s, T, S> {
         self.m.saturating_mul(self.n)
     }
 
+    /// The summed area of the patches the grid has yet to yield (all of them for a new grid),
+    /// each by eq. (12) with the `order`-point rule ([`Patch::area`]): A_A of eqs. (25)–(26).
+    pub fn area(&self, order: usize) -> Result<T, PdmError> {
+        let mut total = T::ZERO;
+        for p in self.clone() {
+            total += p.area(order)?;
+        }
+        Ok(total)
+    }
+
     /// Patch (i, j): i-th along t, j-th along s; `None` outside the grid.
     #[must_use]
     pub fn cell(&self, i: usize, j: usize) -> Option<Patch<'s, T, S>> {

@@ -42,8 +42,8 @@ pub use crate::integrand::mutually_facing;
 /// let (a, b) = (Patch::whole(&floor)?, Patch::whole(&ceiling)?);
 /// let far = Sphere::outer(vec3(5.0, 5.0, 0.5), 1.0)?;
 /// let screen = Disk::new(vec3(0.5, 0.5, 0.5), vec3(0.0, 0.0, 1.0), 2.0)?;
-/// let seen = pair_exchange::<f64, _, _, _, 256>(&a, &b, PairSettings::ACCURATE, &far)?;
-/// let hidden = pair_exchange::<f64, _, _, _, 256>(&a, &b, PairSettings::ACCURATE, &(far, screen))?;
+/// let seen = pair_exchange::<f64, _, _, _, 256>(&a, &b, PairSettings::ACCURATE, &far)?.value;
+/// let hidden = pair_exchange::<f64, _, _, _, 256>(&a, &b, PairSettings::ACCURATE, &(far, screen))?.value;
 /// assert!((seen - 0.1998248956983874).abs() < 1e-13 && hidden == 0.0);
 /// # Ok::<(), pdm_kernel::PdmError>(())
 /// ```

@@ -157,7 +157,11 @@ fn kernel_err(e: PdmError) -> String {
 }
 
 fn grid<'s, T: Real, S: Surface<T>>(surface: &'s S, m: usize, n: usize) -> Result<Vec<Patch<'s, T, S>>, String> {
-    Ok(PatchGrid::new(surface, m, n).map_err(kernel_err)?.collect())
+    Ok(cells(surface, m, n)?.collect())
+}
+
+fn cells<'s, T: Real, S: Surface<T>>(surface: &'s S, m: usize, n: usize) -> Result<PatchGrid<'s, T, S>, String> {
+    PatchGrid::new(surface, m, n).map_err(kernel_err)
 }
 
 /// The result of timing one sweep point.
@@ -228,7 +232,7 @@ pub fn measure<T: Real>(case: CaseId, method: Method, grid_spec: Grid, repeats: 
             };
             let (a, b): (Parallelogram<T>, Parallelogram<T>) = (a.map_err(kernel_err)?, b.map_err(kernel_err)?);
             let problem =
-                Problem { a_groups: vec![grid(&a, n, n)?], b_groups: vec![grid(&b, n, n)?], links: vec![(0, 0)] };
+                Problem { a_groups: vec![grid(&a, n, n)?], b_groups: vec![cells(&b, n, n)?], links: vec![(0, 0)] };
             let (solution, seconds) = time_solve(|| solve(&problem, method, &(), parallel), repeats)?;
             Ok(Measured { solution, seconds, patches: 2 * n * n })
         }
@@ -240,7 +244,7 @@ pub fn measure<T: Real>(case: CaseId, method: Method, grid_spec: Grid, repeats: 
             let square = Parallelogram::new(v(c0[0], c0[1], c0[2]), sub(c1, c0), sub(c3, c0)).map_err(kernel_err)?;
             let problem = Problem {
                 a_groups: vec![grid(&sphere, n, 2 * n)?],
-                b_groups: vec![grid(&square, n, n)?],
+                b_groups: vec![cells(&square, n, n)?],
                 links: vec![(0, 0)],
             };
             let (solution, seconds) = time_solve(|| solve(&problem, method, &(), parallel), repeats)?;
@@ -253,20 +257,21 @@ pub fn measure<T: Real>(case: CaseId, method: Method, grid_spec: Grid, repeats: 
                 return Err("the scene has no sphere".into());
             };
             let faces = scene.faces.iter().map(|f| grid(f, k, k)).collect::<Result<Vec<_>, _>>()?;
+            let face_grids = scene.faces.iter().map(|f| cells(f, k, k)).collect::<Result<Vec<_>, _>>()?;
             let patches = m * n + 6 * k * k;
             let (solution, seconds) = if case == CaseId::SceneSphereFace {
                 // No occluder: the convex sphere's only visibility test is the curvature test
                 // (as in `pdm-ff validate`).
                 let problem = Problem {
                     a_groups: vec![grid(&sphere, m, n)?],
-                    b_groups: faces,
+                    b_groups: face_grids,
                     links: (0..6).map(|f| (0, f)).collect(),
                 };
                 time_solve(|| solve(&problem, method, &(), parallel), repeats)?
             } else {
                 let problem = Problem {
-                    a_groups: faces.clone(),
-                    b_groups: faces,
+                    a_groups: faces,
+                    b_groups: face_grids,
                     links: FACE_PAIRS.iter().map(|&(a, b)| (a - 1, b - 1)).collect(),
                 };
                 time_solve(|| solve(&problem, method, &sphere, parallel), repeats)?
@@ -384,29 +389,6 @@ mod tests {
         assert!(((f64_c11 - FAR_REFERENCE) / FAR_REFERENCE).abs() < 1e-13);
         assert_eq!(references(CaseId::SceneSphereFace).len(), 6);
         assert_eq!(references(CaseId::SceneFaceFace).len(), 15);
-    }
-
-    /// The pair mode's own dispatch gives `pair_exchange`'s value bit for bit.
-    #[test]
-    fn pair_counted_is_pair_exchange() {
-        use pdm_kernel::{pair_exchange, PairSettings};
-        let scene = Scene::<f64>::new(1.0).unwrap();
-        let sphere = scene.sphere.unwrap();
-        let f1: Vec<_> = PatchGrid::new(&scene.faces[0], 2, 2).unwrap().collect();
-        let f2: Vec<_> = PatchGrid::new(&scene.faces[1], 2, 2).unwrap().collect();
-        let s: Vec<_> = PatchGrid::new(&sphere, 2, 4).unwrap().collect();
-        for order in [2, 5] {
-            let set = PairSettings { order, singular_order: order, boundaries: true };
-            for a in &f1 {
-                for b in &f2 {
-                    let (v, n) = super::super::engine::pair_counted::<f64, _, _, _, 64>(a, b, order, &sphere).unwrap();
-                    assert_eq!(v, pair_exchange::<f64, _, _, _, 64>(a, b, set, &sphere).unwrap());
-                    assert!(n > 0);
-                }
-            }
-            let (v, _) = super::super::engine::pair_counted::<f64, _, _, _, 64>(&s[0], &f1[0], order, &()).unwrap();
-            assert_eq!(v, pair_exchange::<f64, _, _, _, 64>(&s[0], &f1[0], set, &()).unwrap());
-        }
     }
 
     /// Paper mode on the scene equals `pdm-ff validate --mode paper` (same sums, same order of

@@ -5,22 +5,22 @@
 //! (emitter group → receiver group) whose factors are wanted, F = Σ_{a ∈ A} Σ_{b ∈ B}
 //! A_a F_{a→b} / Σ_{a ∈ A} A_a (eqs. 25–26). Methods ([`Method`]):
 //!
-//! * `paper` — the paper's eq. (16) on precomputed samples ([`pdm_kernel::exchange`]) at a fixed
-//!   order; areas by eq. (12) with the same rule. Evaluations: order⁴ per patch pair.
+//! * `paper` — the paper's eq. (16) at a fixed order (`pdm_kernel::Method::Paper`); areas by
+//!   eq. (12) with the same rule. Evaluations: order⁴ per patch pair.
 //! * `pair` — [`pdm_kernel::pair_exchange`] with visibility boundaries, the singular order equal
-//!   to the order; areas with the same rule. The dispatch is repeated here with the counting
-//!   variants of the same kernel functions ([`pair_counted`], tested to give `pair_exchange`'s
-//!   value bit for bit). Evaluations: see [`pair_counted`].
+//!   to the order (`Method::Pair`); areas with the same rule. Evaluations: the kernel's own
+//!   count ([`pdm_kernel::Estimate::evaluations`]).
 //! * `adaptive` — [`pdm_kernel::adaptive_exchange`] at a relative tolerance (max order 16, max
-//!   depth 4); areas at order 20. Evaluations: the estimate's own count.
+//!   depth 4; `Method::Tolerance`); areas at order 20. Evaluations: the kernel's own count.
 //!
-//! Work is split into one task per (link, emitter patch); tasks run on the current rayon pool
-//! when `parallel`, and their results are added in task order, so values do not depend on the
-//! thread count.
+//! Work is split into one task per (link, emitter patch), each the emitter patch against the
+//! receiver group's grid by the kernel's substructuring ([`pdm_kernel::surface_exchange`]);
+//! the sample capacity is chosen by [`pdm_kernel::with_capacity`]. Tasks run on the current
+//! rayon pool when `parallel`, and their results are added in task order, so values do not
+//! depend on the thread count.
 
 use pdm_kernel::{
-    adaptive_exchange, exchange, Adaptive, Occluder, PairSettings, Patch, PatchSamples, PdmError, Real, Surface,
-    MAX_ORDER,
+    self as kernel, Adaptive, Occluder, PairSettings, Patch, PatchGrid, PdmError, Quadrature, Real, Surface, MAX_ORDER,
 };
 use rayon::prelude::*;
 
@@ -71,6 +71,15 @@ impl Method {
         }
     }
 
+    /// Order of the emitter areas: the method's order, [`ADAPTIVE_AREA_ORDER`] in adaptive mode.
+    #[must_use]
+    pub fn area_order(self) -> usize {
+        match self {
+            Self::Paper { order } | Self::Pair { order } => order,
+            Self::Adaptive { .. } => ADAPTIVE_AREA_ORDER,
+        }
+    }
+
     /// The tolerance (adaptive mode only).
     #[must_use]
     pub fn tolerance(self) -> Option<f64> {
@@ -86,8 +95,8 @@ impl Method {
 pub struct Problem<'s, T, SA: ?Sized, SB: ?Sized> {
     /// Emitter groups (a surface's patches each).
     pub a_groups: Vec<Vec<Patch<'s, T, SA>>>,
-    /// Receiver groups.
-    pub b_groups: Vec<Vec<Patch<'s, T, SB>>>,
+    /// Receiver groups (a grid of a surface's patches each).
+    pub b_groups: Vec<PatchGrid<'s, T, SB>>,
     /// (emitter group, receiver group) pairs.
     pub links: Vec<(usize, usize)>,
 }
@@ -126,22 +135,49 @@ where
     SB: Surface<T> + Sync + ?Sized,
     O: Occluder<T> + Sync + ?Sized,
 {
-    let need = match method {
+    let (kernel_method, need) = match method {
         Method::Paper { order } | Method::Pair { order } => {
             if !(1..=MAX_ORDER).contains(&order) {
                 return Err(format!("order {order} outside 1..={MAX_ORDER}"));
             }
-            order * order
+            let m = match method {
+                Method::Paper { .. } => kernel::Method::Paper(Quadrature::uniform(order)),
+                _ => kernel::Method::Pair(PairSettings { order, singular_order: order, boundaries: true }),
+            };
+            (m, order * order)
         }
-        Method::Adaptive { .. } => (ADAPTIVE_MAX_ORDER + 2) * (ADAPTIVE_MAX_ORDER + 2),
+        Method::Adaptive { tolerance } => {
+            let settings = Adaptive {
+                tolerance: T::from_f64(tolerance),
+                max_order: ADAPTIVE_MAX_ORDER,
+                max_depth: ADAPTIVE_MAX_DEPTH,
+            };
+            (kernel::Method::Tolerance(settings), (ADAPTIVE_MAX_ORDER + 2) * (ADAPTIVE_MAX_ORDER + 2))
+        }
     };
-    match need {
-        0..=25 => solve_cap::<T, SA, SB, O, 25>(problem, method, occluders, parallel),
-        26..=64 => solve_cap::<T, SA, SB, O, 64>(problem, method, occluders, parallel),
-        65..=144 => solve_cap::<T, SA, SB, O, 144>(problem, method, occluders, parallel),
-        145..=256 => solve_cap::<T, SA, SB, O, 256>(problem, method, occluders, parallel),
-        257..=576 => solve_cap::<T, SA, SB, O, 576>(problem, method, occluders, parallel),
-        _ => solve_cap::<T, SA, SB, O, { MAX_ORDER * MAX_ORDER }>(problem, method, occluders, parallel),
+    let job = Job { problem, method: kernel_method, area_order: method.area_order(), occluders, parallel };
+    kernel::with_capacity(need, job).map_err(kernel_err("choosing the sample capacity"))?
+}
+
+/// [`solve`] at one sample capacity, chosen by [`kernel::with_capacity`].
+struct Job<'p, 's, T, SA: ?Sized, SB: ?Sized, O: ?Sized> {
+    problem: &'p Problem<'s, T, SA, SB>,
+    method: kernel::Method<T>,
+    area_order: usize,
+    occluders: &'p O,
+    parallel: bool,
+}
+
+impl<T, SA, SB, O> kernel::WithCapacity for Job<'_, '_, T, SA, SB, O>
+where
+    T: Real,
+    SA: Surface<T> + Sync + ?Sized,
+    SB: Surface<T> + Sync + ?Sized,
+    O: Occluder<T> + Sync + ?Sized,
+{
+    type Output = Result<Solution, String>;
+    fn run<const CAP: usize>(self) -> Self::Output {
+        solve_cap::<T, SA, SB, O, CAP>(self.problem, self.method, self.area_order, self.occluders, self.parallel)
     }
 }
 
@@ -171,9 +207,12 @@ fn per_link<T: Real>(links: usize, results: &[(usize, T, u64)]) -> (Vec<T>, u64)
     (sums, evaluations)
 }
 
+/// One task per (link, emitter patch): the emitter patch against the receiver group's grid by
+/// the kernel's substructuring ([`kernel::surface_exchange`]).
 fn solve_cap<T, SA, SB, O, const CAP: usize>(
     problem: &Problem<'_, T, SA, SB>,
-    method: Method,
+    method: kernel::Method<T>,
+    area_order: usize,
     occluders: &O,
     parallel: bool,
 ) -> Result<Solution, String>
@@ -184,86 +223,33 @@ where
     O: Occluder<T> + Sync + ?Sized,
 {
     let links = problem.links.len();
-    let (exchanges, areas, evaluations): (Vec<T>, Vec<T>, u64) = match method {
-        Method::Paper { order } => {
-            let sample = |p: &Patch<'_, T, SA>| PatchSamples::<T, CAP>::new(p, order);
-            let a_samples = problem
-                .a_groups
-                .iter()
-                .map(|g| g.iter().map(sample).collect::<Result<Vec<_>, _>>())
-                .collect::<Result<Vec<_>, _>>()
-                .map_err(kernel_err("sampling an emitter patch"))?;
-            let b_samples = problem
-                .b_groups
-                .iter()
-                .map(|g| g.iter().map(|p| PatchSamples::<T, CAP>::new(p, order)).collect::<Result<Vec<_>, _>>())
-                .collect::<Result<Vec<_>, _>>()
-                .map_err(kernel_err("sampling a receiver patch"))?;
-            let mut tasks = Vec::new();
-            for (link, &(ga, gb)) in problem.links.iter().enumerate() {
-                let (Some(sa), Some(sb)) = (a_samples.get(ga), b_samples.get(gb)) else {
-                    return Err(format!("link {link}: no group {ga} or {gb}"));
-                };
-                tasks.extend(sa.iter().map(|s| (link, s, sb.as_slice())));
-            }
-            let results = map_tasks(&tasks, parallel, |&(link, sa, sbs)| {
-                let mut acc = T::ZERO;
-                let mut n = 0u64;
-                for sb in sbs {
-                    acc += exchange(sa, sb, occluders).map_err(kernel_err("paper-mode sum"))?;
-                    n += (sa.len() * sb.len()) as u64;
-                }
-                Ok((link, acc, n))
-            })?;
-            let (sums, evaluations) = per_link(links, &results);
-            let areas = a_samples.iter().map(|g| g.iter().fold(T::ZERO, |acc, s| acc + s.area())).collect();
-            (sums, areas, evaluations)
-        }
-        Method::Pair { .. } | Method::Adaptive { .. } => {
-            let order = method.order();
-            let mut tasks = Vec::new();
-            for (link, &(ga, gb)) in problem.links.iter().enumerate() {
-                let (Some(pa), Some(pb)) = (problem.a_groups.get(ga), problem.b_groups.get(gb)) else {
-                    return Err(format!("link {link}: no group {ga} or {gb}"));
-                };
-                tasks.extend(pa.iter().map(|p| (link, p, pb.as_slice())));
-            }
-            let tolerance = T::from_f64(method.tolerance().unwrap_or(1.0));
-            let settings = Adaptive { tolerance, max_order: ADAPTIVE_MAX_ORDER, max_depth: ADAPTIVE_MAX_DEPTH };
-            let results = map_tasks(&tasks, parallel, |&(link, pa, pbs)| {
-                let mut acc = T::ZERO;
-                let mut n = 0u64;
-                for pb in pbs {
-                    let (v, k) = match method {
-                        Method::Adaptive { .. } => {
-                            let e = adaptive_exchange::<T, SA, SB, O, CAP>(pa, pb, settings, occluders)
-                                .map_err(kernel_err("adaptive_exchange"))?;
-                            (e.value, e.evaluations)
-                        }
-                        _ => pair_counted::<T, SA, SB, O, CAP>(pa, pb, order, occluders)
-                            .map_err(kernel_err("pair_exchange"))?,
-                    };
-                    acc += v;
-                    n = n.saturating_add(k);
-                }
-                Ok((link, acc, n))
-            })?;
-            let (sums, evaluations) = per_link(links, &results);
-            let area_order = match method {
-                Method::Adaptive { .. } => ADAPTIVE_AREA_ORDER,
-                _ => order,
-            };
-            let mut areas = Vec::with_capacity(problem.a_groups.len());
-            for g in &problem.a_groups {
-                let mut a = T::ZERO;
-                for p in g {
-                    a += p.area(area_order).map_err(kernel_err("patch area"))?;
-                }
-                areas.push(a);
-            }
-            (sums, areas, evaluations)
-        }
+    let mut tasks = Vec::new();
+    for (link, &(ga, gb)) in problem.links.iter().enumerate() {
+        let (Some(pa), Some(grid_b)) = (problem.a_groups.get(ga), problem.b_groups.get(gb)) else {
+            return Err(format!("link {link}: no group {ga} or {gb}"));
+        };
+        tasks.extend(pa.iter().map(|p| (link, p, grid_b)));
+    }
+    let what = match method {
+        kernel::Method::Paper(_) => "paper-mode sum",
+        kernel::Method::Tolerance(_) => "adaptive_exchange",
+        _ => "pair_exchange",
     };
+    let results = map_tasks(&tasks, parallel, |&(link, pa, grid_b)| {
+        let grid_a = pa.grid(1, 1).map_err(kernel_err("emitter patch"))?;
+        let e = kernel::surface_exchange::<T, SA, SB, O, CAP>(grid_a, grid_b.clone(), method, occluders)
+            .map_err(kernel_err(what))?;
+        Ok((link, e.value, e.evaluations))
+    })?;
+    let (exchanges, evaluations) = per_link(links, &results);
+    let mut areas = Vec::with_capacity(problem.a_groups.len());
+    for g in &problem.a_groups {
+        let mut a = T::ZERO;
+        for p in g {
+            a += p.area(area_order).map_err(kernel_err("patch area"))?;
+        }
+        areas.push(a);
+    }
     let mut values = Vec::with_capacity(links);
     for (&(ga, _), e) in problem.links.iter().zip(&exchanges) {
         let area = areas.get(ga).copied().unwrap_or(T::ZERO);
@@ -274,25 +260,4 @@ where
         values.push(f);
     }
     Ok(Solution { values, evaluations })
-}
-
-/// `pdm_kernel::internals::pair_exchange_counted` with `PairSettings { order, singular_order: order,
-/// boundaries: true }`: (A_a F_{a→b}, evaluations), as the kernel counts them (kernel
-/// evaluations and visibility probes on the boundary path, order⁴ for the straddle check and
-/// for a plain sum, 6·order⁴ for a shared edge, 4·order⁴ for a shared vertex). The test
-/// `pair_counted_is_pair_exchange` checks that the value is `pair_exchange`'s bit for bit.
-pub fn pair_counted<T, SA, SB, O, const CAP: usize>(
-    a: &Patch<'_, T, SA>,
-    b: &Patch<'_, T, SB>,
-    order: usize,
-    occluders: &O,
-) -> Result<(T, u64), PdmError>
-where
-    T: Real,
-    SA: Surface<T> + ?Sized,
-    SB: Surface<T> + ?Sized,
-    O: Occluder<T> + ?Sized,
-{
-    let settings = PairSettings { order, singular_order: order, boundaries: true };
-    pdm_kernel::internals::pair_exchange_counted::<T, SA, SB, O, CAP>(a, b, settings, occluders)
 }

@@ -186,7 +186,9 @@ fn measure_emitter<S: Surface<f64> + Sync>(
     let mut b_groups = Vec::new();
     for face in &scene.faces {
         let g = PatchGrid::new(face, RECEIVER_GRID, RECEIVER_GRID).map_err(|e| format!("face grid: {e}"))?;
-        b_groups.extend(g.map(|p| vec![p]));
+        for p in g {
+            b_groups.push(p.grid(1, 1).map_err(|e| format!("receiver cell: {e}"))?);
+        }
     }
     let links = (0..b_groups.len()).map(|g| (0, g)).collect();
     let problem = Problem { a_groups: vec![emitter.to_vec()], b_groups, links };

@@ -1,13 +1,15 @@
 //! The two computations (`--mode paper` and `--mode accurate`), generic over the precision `T`
-//! and the sample capacity `CAP` (≥ order²), parallelised over outer patches with rayon (the
-//! kernel itself is single-threaded). Partial sums are collected in task order and added
+//! and the sample capacity `CAP` (≥ order²). Each task is one row of eqs. (25)–(26), an outer
+//! patch against a whole face's grid, summed by the kernel's substructuring
+//! ([`pdm_kernel::surface_exchange`]); the tasks run in parallel with rayon (the kernel itself
+//! is single-threaded). Partial sums are collected in task order and added
 //! sequentially, so results do not depend on the number of threads.
 
 use std::time::Instant;
 
 use pdm_kernel::{
-    adaptive_exchange, form_factor, pair_exchange, Adaptive, Occluder, PairSettings, Parallelogram, Patch, PatchGrid,
-    PatchSamples, PdmError, Real, Sphere, Surface,
+    surface_exchange, Adaptive, Estimate, Method, Occluder, PairSettings, Parallelogram, Patch, PatchGrid, PdmError,
+    Quadrature, Real, Sphere, Surface,
 };
 use rayon::prelude::*;
 
@@ -33,10 +35,11 @@ pub struct Values {
     /// factors, each the sum of its patch pairs' estimates relative to the factor
     /// (`adaptive_exchange`'s `Estimate::error`); `None` in the fixed modes.
     pub estimated_error: Option<f64>,
-    /// Tolerance mode only: the number of patch pairs whose estimate did not meet the
+    /// Tolerance mode only: the number of rows (an outer patch against a whole face, eqs.
+    /// 25–26) whose summed estimate did not meet the
     /// tolerance (`Estimate::converged` false: subdivision limit or precision floor);
     /// `None` in the fixed modes.
-    pub unconverged_pairs: Option<u64>,
+    pub unconverged_rows: Option<u64>,
 }
 
 /// Wall times of one computation, seconds.
@@ -87,10 +90,7 @@ pub fn run_once<T: Real, const CAP: usize>(
             let (m, n) = cfg.sphere_grid;
             let sphere_patches: Vec<Patch<'_, T, Sphere<T>>> =
                 PatchGrid::new(sphere, m, n).map_err(kernel("sphere grid"))?.collect();
-            Some(match cfg.mode {
-                Mode::Paper => paper_sphere_face::<T, CAP>(cfg, &sphere_patches, &face_patches, progress)?,
-                Mode::Accurate => accurate_sphere_face::<T, CAP>(cfg, &sphere_patches, &face_patches, progress)?,
-            })
+            Some(sphere_face::<T, CAP>(cfg, &sphere_patches, &scene.faces, &face_patches, progress)?)
         }
         None => None,
     };
@@ -99,13 +99,8 @@ pub fn run_once<T: Real, const CAP: usize>(
     // Part 2: face → face (Table 3), eq. (26), the sphere as occluder.
     progress.stage("face -> face");
     let start = Instant::now();
-    let (face_exchange, face_area, face_error, face_unconverged) = match cfg.mode {
-        Mode::Paper => {
-            let (exchange, area) = paper_face_face::<T, CAP>(cfg, &scene.sphere, &face_patches, progress)?;
-            (exchange, area, [T::ZERO; 15], 0)
-        }
-        Mode::Accurate => accurate_face_face::<T, CAP>(cfg, &scene.sphere, &face_patches, progress)?,
-    };
+    let (face_exchange, face_area, face_error, face_unconverged) =
+        face_face::<T, CAP>(cfg, &scene.sphere, &scene.faces, &face_patches, progress)?;
     let face_face_seconds = start.elapsed().as_secs_f64();
 
     // The kernel's estimates relative to the exchange they belong to (tolerance mode).
@@ -115,10 +110,10 @@ pub fn run_once<T: Real, const CAP: usize>(
         let sphere = part1.iter().flat_map(|p| p.error.iter().zip(&p.exchange).map(|(&e, &x)| relative(e, x)));
         faces.chain(sphere).fold(0.0, f64::max)
     });
-    let unconverged_pairs = cfg.tolerance.map(|_| face_unconverged + part1.as_ref().map_or(0, |p| p.unconverged));
+    let unconverged_rows = cfg.tolerance.map(|_| face_unconverged + part1.as_ref().map_or(0, |p| p.unconverged));
     let mut values = derive(part1, &face_exchange, &face_area)?;
     values.estimated_error = estimated_error;
-    values.unconverged_pairs = unconverged_pairs;
+    values.unconverged_rows = unconverged_rows;
     Ok((values, Times { sphere_face: sphere_face_seconds, face_face: face_face_seconds }))
 }
 
@@ -127,7 +122,7 @@ struct SpherePart<T> {
     exchange: [T; 6],
     /// Σ of the kernel's error estimates per face (tolerance mode; zero otherwise).
     error: [T; 6],
-    /// Patch pairs that did not converge (tolerance mode; zero otherwise).
+    /// Rows that did not converge (tolerance mode; zero otherwise).
     unconverged: u64,
     sphere_area: T,
     face_area: [T; 6],
@@ -181,7 +176,7 @@ fn derive<T: Real>(
         sphere_area,
         face_area: face_area.map(Real::to_f64),
         estimated_error: None,
-        unconverged_pairs: None,
+        unconverged_rows: None,
     })
 }
 
@@ -198,129 +193,44 @@ fn chunk_sums<T: Real, const N: usize>(partial: &[T], chunk: usize) -> [T; N] {
     out
 }
 
-fn sample_all<T: Real, S: pdm_kernel::Surface<T> + Sync + ?Sized, const CAP: usize>(
-    patches: &[Patch<'_, T, S>],
-    order: usize,
-) -> Result<Vec<PatchSamples<T, CAP>>, ValidateError> {
-    patches.par_iter().map(|p| PatchSamples::<T, CAP>::new(p, order).map_err(kernel("sampling a patch"))).collect()
-}
-
-fn total_area<T: Real, const CAP: usize>(samples: &[PatchSamples<T, CAP>]) -> T {
-    let mut a = T::ZERO;
-    for s in samples {
-        a += s.area();
-    }
-    a
-}
-
-/// Paper mode, part 1: eq. (25) with plain eq. (16) sums on precomputed samples, no occluder
-/// (the sphere is convex: the curvature test is its only visibility test against the faces).
-fn paper_sphere_face<T: Real, const CAP: usize>(
-    cfg: &RunConfig,
-    sphere_patches: &[Patch<'_, T, Sphere<T>>],
-    face_patches: &[Vec<Patch<'_, T, Face<T>>>],
-    progress: &dyn Progress,
-) -> Result<SpherePart<T>, ValidateError> {
-    let ss = sample_all::<T, Sphere<T>, CAP>(sphere_patches, cfg.order)?;
-    let fs = face_patches.iter().map(|f| sample_all::<T, Face<T>, CAP>(f, cfg.order)).collect::<Result<Vec<_>, _>>()?;
-    let tasks: Vec<(&PatchSamples<T, CAP>, &[PatchSamples<T, CAP>])> =
-        fs.iter().flat_map(|face| ss.iter().map(move |s| (s, face.as_slice()))).collect();
-    let partial = tasks
-        .par_iter()
-        .map(|&(sa, face)| {
-            let mut acc = T::ZERO;
-            for sb in face {
-                // Eq. (25): A_ps · F_ps→pf.
-                acc += form_factor(sa, sb, &()).map_err(kernel("sphere patch -> face patch"))? * sa.area();
-            }
-            progress.advance(1);
-            Ok(acc)
-        })
-        .collect::<Result<Vec<T>, ValidateError>>()?;
-    let mut face_area = [T::ZERO; 6];
-    for (a, f) in face_area.iter_mut().zip(&fs) {
-        *a = total_area(f);
-    }
-    Ok(SpherePart {
-        exchange: chunk_sums(&partial, ss.len()),
-        error: [T::ZERO; 6],
-        unconverged: 0,
-        sphere_area: total_area(&ss),
-        face_area,
-    })
-}
-
-/// Paper mode, part 2: eq. (26) with plain eq. (16) sums, the sphere as occluder; edge-adjacent
-/// patch pairs get the plain sum too (Gauss nodes are interior, so L never vanishes and the
-/// paper's L'Hôpital correction never triggers).
-fn paper_face_face<T: Real, const CAP: usize>(
-    cfg: &RunConfig,
-    sphere: &Option<Sphere<T>>,
-    face_patches: &[Vec<Patch<'_, T, Face<T>>>],
-    progress: &dyn Progress,
-) -> Result<([T; 15], [T; 6]), ValidateError> {
-    let fs = face_patches.iter().map(|f| sample_all::<T, Face<T>, CAP>(f, cfg.order)).collect::<Result<Vec<_>, _>>()?;
-    let per_pair = cfg.face_grid * cfg.face_grid;
-    let mut tasks: Vec<(&PatchSamples<T, CAP>, &[PatchSamples<T, CAP>])> = Vec::new();
-    for &(a, b) in &FACE_PAIRS {
-        if let (Some(fa), Some(fb)) = (fs.get(a - 1), fs.get(b - 1)) {
-            tasks.extend(fa.iter().map(|s| (s, fb.as_slice())));
+/// How every patch pair of a run is integrated: the paper's bare eq. (16) sum (paper mode),
+/// [`pdm_kernel::pair_exchange`] at the configured orders, or [`pdm_kernel::adaptive_exchange`] to
+/// the configured tolerance (accurate mode).
+fn method<T: Real>(cfg: &RunConfig) -> Method<T> {
+    match (cfg.mode, cfg.tolerance) {
+        (Mode::Paper, _) => Method::Paper(Quadrature::uniform(cfg.order)),
+        (Mode::Accurate, Some(tol)) => Method::Tolerance(Adaptive {
+            tolerance: T::from_f64(tol),
+            max_order: ADAPTIVE_MAX_ORDER,
+            max_depth: super::stack::ADAPTIVE_MAX_DEPTH,
+        }),
+        (Mode::Accurate, None) => {
+            Method::Pair(PairSettings { order: cfg.order, singular_order: cfg.singular_order, boundaries: true })
         }
     }
-    let partial = tasks
-        .par_iter()
-        .map(|&(sa, face_b)| {
-            let mut acc = T::ZERO;
-            for sb in face_b {
-                acc += form_factor(sa, sb, sphere).map_err(kernel("face patch -> face patch"))? * sa.area();
-            }
-            progress.advance(1);
-            Ok(acc)
-        })
-        .collect::<Result<Vec<T>, ValidateError>>()?;
-    let mut face_area = [T::ZERO; 6];
-    for (a, f) in face_area.iter_mut().zip(&fs) {
-        *a = total_area(f);
-    }
-    Ok((chunk_sums(&partial, per_pair), face_area))
 }
 
 /// Largest Gauss order the tolerance mode uses before subdividing a pair.
 pub const ADAPTIVE_MAX_ORDER: usize = 12;
 
-/// A_a·F_{a→b} for one patch pair in accurate mode: [`pair_exchange`] at the configured orders,
-/// or [`adaptive_exchange`] to the configured tolerance: (value, error estimate, 1 if the
-/// estimate did not meet the tolerance else 0).
-fn accurate_pair<T, SA, SB, O, const CAP: usize>(
-    cfg: &RunConfig,
-    a: &Patch<'_, T, SA>,
-    b: &Patch<'_, T, SB>,
+/// One row of eqs. (25)–(26): outer patch `pa` against every patch of grid `b`, by the kernel's
+/// substructuring ([`surface_exchange`]).
+fn row<T, SA, SB, O, const CAP: usize>(
+    pa: &Patch<'_, T, SA>,
+    b: PatchGrid<'_, T, SB>,
+    method: Method<T>,
     occluders: &O,
-) -> Result<(T, T, u64), PdmError>
+) -> Result<Estimate<T>, PdmError>
 where
     T: Real,
     SA: Surface<T> + ?Sized,
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
-    match cfg.tolerance {
-        Some(tol) => {
-            let settings = Adaptive {
-                tolerance: T::from_f64(tol),
-                max_order: ADAPTIVE_MAX_ORDER,
-                max_depth: super::stack::ADAPTIVE_MAX_DEPTH,
-            };
-            adaptive_exchange::<T, SA, SB, O, CAP>(a, b, settings, occluders)
-                .map(|e| (e.value, e.error, u64::from(!e.converged)))
-        }
-        None => pair_exchange::<T, SA, SB, O, CAP>(a, b, settings(cfg), occluders).map(|v| (v, T::ZERO, 0)),
-    }
+    surface_exchange::<T, SA, SB, O, CAP>(pa.grid(1, 1)?, b, method, occluders)
 }
 
-fn settings(cfg: &RunConfig) -> PairSettings {
-    PairSettings { order: cfg.order, singular_order: cfg.singular_order, boundaries: true }
-}
-
+/// Σ of the patch areas by eq. (12) with the run's rule.
 fn areas<T: Real, S: pdm_kernel::Surface<T> + Sync + ?Sized>(
     patches: &[Patch<'_, T, S>],
     order: usize,
@@ -334,83 +244,80 @@ fn areas<T: Real, S: pdm_kernel::Surface<T> + Sync + ?Sized>(
     Ok(a)
 }
 
-/// Accurate mode, part 1: [`pair_exchange`] (visibility boundaries in the rule) for every
-/// sphere patch × face patch; no occluder (the convex sphere is handled by the back-face cut).
-fn accurate_sphere_face<T: Real, const CAP: usize>(
+/// Per-task estimates (in task order) as chunked exchange sums, chunked sums of the error
+/// estimates (zero where there are none), and the number of tasks that did not converge
+/// (tolerance mode only).
+fn totals<T: Real, const N: usize>(rows: &[Estimate<T>], chunk: usize) -> ([T; N], [T; N], u64) {
+    let values: Vec<T> = rows.iter().map(|e| e.value).collect();
+    let errors: Vec<T> = rows.iter().map(|e| e.error.unwrap_or(T::ZERO)).collect();
+    let unconverged = rows.iter().filter(|e| e.error.is_some() && !e.converged).count() as u64;
+    (chunk_sums(&values, chunk), chunk_sums(&errors, chunk), unconverged)
+}
+
+/// Part 1, eq. (25): every sphere patch against every face's grid, no occluder (the sphere is
+/// convex: the curvature test is its only visibility test against the faces).
+fn sphere_face<T: Real, const CAP: usize>(
     cfg: &RunConfig,
     sphere_patches: &[Patch<'_, T, Sphere<T>>],
+    faces: &[Face<T>],
     face_patches: &[Vec<Patch<'_, T, Face<T>>>],
     progress: &dyn Progress,
 ) -> Result<SpherePart<T>, ValidateError> {
-    type Task<'a, 'p, T> = (&'a Patch<'p, T, Sphere<T>>, &'a [Patch<'p, T, Face<T>>]);
+    let method = method::<T>(cfg);
+    let k = cfg.face_grid;
+    type Task<'a, 'p, T> = (&'a Patch<'p, T, Sphere<T>>, &'a Face<T>);
     let tasks: Vec<Task<'_, '_, T>> =
-        face_patches.iter().flat_map(|face| sphere_patches.iter().map(move |s| (s, face.as_slice()))).collect();
-    let partial = tasks
+        faces.iter().flat_map(|face| sphere_patches.iter().map(move |s| (s, face))).collect();
+    let rows = tasks
         .par_iter()
         .map(|&(ps, face)| {
-            let (mut acc, mut err, mut missed) = (T::ZERO, T::ZERO, 0u64);
-            for pf in face {
-                let (v, e, m) =
-                    accurate_pair::<T, _, _, _, CAP>(cfg, ps, pf, &()).map_err(kernel("sphere patch -> face patch"))?;
-                acc += v;
-                err += e;
-                missed += m;
-            }
+            let grid = PatchGrid::new(face, k, k).map_err(kernel("face grid"))?;
+            let e = row::<T, _, _, _, CAP>(ps, grid, method, &()).map_err(kernel("sphere patch -> face"))?;
             progress.advance(1);
-            Ok((acc, err, missed))
+            Ok(e)
         })
-        .collect::<Result<Vec<(T, T, u64)>, ValidateError>>()?;
-    let unconverged = partial.iter().map(|&(_, _, m)| m).sum();
-    let (values, errors): (Vec<T>, Vec<T>) = partial.into_iter().map(|(v, e, _)| (v, e)).unzip();
+        .collect::<Result<Vec<Estimate<T>>, ValidateError>>()?;
+    let (exchange, error, unconverged) = totals(&rows, sphere_patches.len());
     let mut face_area = [T::ZERO; 6];
     for (a, f) in face_area.iter_mut().zip(face_patches) {
         *a = areas(f, cfg.order)?;
     }
-    Ok(SpherePart {
-        exchange: chunk_sums(&values, sphere_patches.len()),
-        error: chunk_sums(&errors, sphere_patches.len()),
-        unconverged,
-        sphere_area: areas(sphere_patches, cfg.order)?,
-        face_area,
-    })
+    Ok(SpherePart { exchange, error, unconverged, sphere_area: areas(sphere_patches, cfg.order)?, face_area })
 }
 
-/// Accurate mode, part 2: [`pair_exchange`] for every face patch pair (shared-edge and
-/// shared-vertex transforms, boundary-aware sums elsewhere), the sphere as occluder.
-fn accurate_face_face<T: Real, const CAP: usize>(
+/// Part 2, eq. (26): every patch of face a against face b's grid for the 15 face pairs, the
+/// sphere as occluder. In paper mode edge-adjacent patch pairs get the bare sum too (Gauss
+/// nodes are interior, so L never vanishes and the paper's L'Hôpital correction never
+/// triggers); in accurate mode the shared-edge and shared-vertex transforms take them.
+fn face_face<T: Real, const CAP: usize>(
     cfg: &RunConfig,
     sphere: &Option<Sphere<T>>,
+    faces: &[Face<T>],
     face_patches: &[Vec<Patch<'_, T, Face<T>>>],
     progress: &dyn Progress,
 ) -> Result<FaceFaceSums<T>, ValidateError> {
-    let per_pair = cfg.face_grid * cfg.face_grid;
-    type Task<'a, 'p, T> = (&'a Patch<'p, T, Face<T>>, &'a [Patch<'p, T, Face<T>>]);
+    let method = method::<T>(cfg);
+    let k = cfg.face_grid;
+    type Task<'a, 'p, T> = (&'a Patch<'p, T, Face<T>>, &'a Face<T>);
     let mut tasks: Vec<Task<'_, '_, T>> = Vec::new();
     for &(a, b) in &FACE_PAIRS {
-        if let (Some(fa), Some(fb)) = (face_patches.get(a - 1), face_patches.get(b - 1)) {
-            tasks.extend(fa.iter().map(|p| (p, fb.as_slice())));
+        if let (Some(fa), Some(fb)) = (face_patches.get(a - 1), faces.get(b - 1)) {
+            tasks.extend(fa.iter().map(|p| (p, fb)));
         }
     }
-    let partial = tasks
+    let rows = tasks
         .par_iter()
         .map(|&(pa, face_b)| {
-            let (mut acc, mut err, mut missed) = (T::ZERO, T::ZERO, 0u64);
-            for pb in face_b {
-                let (v, e, m) = accurate_pair::<T, _, _, _, CAP>(cfg, pa, pb, sphere)
-                    .map_err(kernel("face patch -> face patch"))?;
-                acc += v;
-                err += e;
-                missed += m;
-            }
+            let grid = PatchGrid::new(face_b, k, k).map_err(kernel("face grid"))?;
+            let e = row::<T, _, _, _, CAP>(pa, grid, method, sphere).map_err(kernel("face patch -> face"))?;
             progress.advance(1);
-            Ok((acc, err, missed))
+            Ok(e)
         })
-        .collect::<Result<Vec<(T, T, u64)>, ValidateError>>()?;
-    let unconverged = partial.iter().map(|&(_, _, m)| m).sum();
-    let (values, errors): (Vec<T>, Vec<T>) = partial.into_iter().map(|(v, e, _)| (v, e)).unzip();
+        .collect::<Result<Vec<Estimate<T>>, ValidateError>>()?;
+    let (exchange, error, unconverged) = totals(&rows, k * k);
     let mut face_area = [T::ZERO; 6];
     for (a, f) in face_area.iter_mut().zip(face_patches) {
         *a = areas(f, cfg.order)?;
     }
-    Ok((chunk_sums(&values, per_pair), face_area, chunk_sums(&errors, per_pair), unconverged))
+    Ok((exchange, face_area, error, unconverged))
 }

@@ -74,9 +74,10 @@ impl Precision {
 pub const MAX_FACE_GRID: usize = 64;
 /// Largest sphere grid dimension (M or N) accepted.
 pub const MAX_SPHERE_GRID: usize = 256;
-/// Largest heap for the samples of paper mode ([`RunConfig::sample_memory`]): 1 GiB, e.g.
-/// a 256 × 256 sphere grid up to order 16 (3.8 GiB at order 32 are refused).
-pub const MAX_SAMPLE_MEMORY: usize = 1 << 30;
+/// Largest number of kernel evaluations of a paper-mode run ([`RunConfig::paper_evaluations`]):
+/// 1e12, hours on this kind of machine; e.g. a 256 × 256 sphere grid is accepted up to order 16
+/// (4e11) and refused at order 32 (7e12).
+pub const MAX_PAPER_EVALUATIONS: f64 = 1e12;
 /// Largest `--repeat`.
 pub const MAX_REPEAT: usize = 1000;
 
@@ -134,17 +135,14 @@ impl RunConfig {
             }
         }
         if self.mode == Mode::Paper {
-            let bytes = self.sample_memory();
-            if bytes > MAX_SAMPLE_MEMORY {
+            let evaluations = self.paper_evaluations();
+            if evaluations > MAX_PAPER_EVALUATIONS {
                 return bad(
                     "sphere grid",
                     format!("{m}x{n} with face grid {} and order {}", self.face_grid, self.order),
                     &format!(
-                        "paper mode keeps the samples of all {} patches in memory, {:.1} GiB > {} GiB; \
-                         use a smaller grid or order",
-                        self.total_patches(),
-                        bytes as f64 / f64::from(1u32 << 30),
-                        MAX_SAMPLE_MEMORY >> 30
+                        "paper mode would take {evaluations:.1e} kernel evaluations (over {MAX_PAPER_EVALUATIONS:.0e}, \
+                         hours); use a smaller grid or order"
                     ),
                 );
             }
@@ -162,11 +160,13 @@ impl RunConfig {
         }
     }
 
-    /// Heap bytes of the samples paper mode keeps (every patch sampled once, f64,
-    /// `PatchSamples` of [`capacity`]).
+    /// Kernel evaluations of a paper-mode run: order⁴ for each of its patch pairs (every
+    /// sphere patch against the 6 K² face patches, and the 15 face pairs' K⁴ patch pairs).
     #[must_use]
-    pub fn sample_memory(&self) -> usize {
-        self.total_patches().saturating_mul(stack::samples_bytes::<f64>(capacity(self)))
+    pub fn paper_evaluations(&self) -> f64 {
+        let k2 = (self.face_grid * self.face_grid) as f64;
+        let pairs = self.sphere_patches() as f64 * 6.0 * k2 + 15.0 * k2 * k2;
+        pairs * (self.order as f64).powi(4)
     }
 
     /// Total patch count: sphere patches + 6 K².
@@ -312,17 +312,23 @@ pub fn capacity(cfg: &RunConfig) -> usize {
     stack::capacity_for(order)
 }
 
-/// Runs [`compute::run_once`] with the capacity [`capacity`] picks.
+/// Runs [`compute::run_once`] with the capacity [`capacity`] picks
+/// ([`pdm_kernel::with_capacity`]).
 fn run_dispatch<T: Real>(cfg: &RunConfig, progress: &dyn Progress) -> Result<(Values, Times), ValidateError> {
-    use compute::run_once;
-    match capacity(cfg) {
-        25 => run_once::<T, 25>(cfg, progress),
-        64 => run_once::<T, 64>(cfg, progress),
-        144 => run_once::<T, 144>(cfg, progress),
-        256 => run_once::<T, 256>(cfg, progress),
-        576 => run_once::<T, 576>(cfg, progress),
-        _ => run_once::<T, { MAX_ORDER * MAX_ORDER }>(cfg, progress),
+    struct Run<'c, T> {
+        cfg: &'c RunConfig,
+        progress: &'c dyn Progress,
+        precision: std::marker::PhantomData<T>,
     }
+    impl<T: Real> pdm_kernel::WithCapacity for Run<'_, T> {
+        type Output = Result<(Values, Times), ValidateError>;
+        fn run<const CAP: usize>(self) -> Self::Output {
+            compute::run_once::<T, CAP>(self.cfg, self.progress)
+        }
+    }
+    let run = Run::<T> { cfg, progress, precision: std::marker::PhantomData };
+    pdm_kernel::with_capacity(capacity(cfg), run)
+        .map_err(|error| ValidateError::Kernel { context: "choosing the sample capacity", error })?
 }
 
 #[cfg(test)]

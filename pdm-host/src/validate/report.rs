@@ -121,7 +121,7 @@ struct OutcomeJson<'a> {
     face_to_face: PairMap,
     face_sum: &'a [f64; 6],
     estimated_error: Option<f64>,
-    unconverged_pairs: Option<u64>,
+    unconverged_rows: Option<u64>,
     reference: ReferenceJson<'a>,
     relative_error: RelativeErrorJson,
     paper: Option<PaperJson>,
@@ -248,7 +248,7 @@ impl Report {
             face_to_face: pair_object(&v.face_to_face),
             face_sum: &v.face_sum,
             estimated_error: v.estimated_error,
-            unconverged_pairs: v.unconverged_pairs,
+            unconverged_rows: v.unconverged_rows,
             reference: self.reference_json(),
             relative_error: RelativeErrorJson {
                 sphere_to_face: pair_err(&v.sphere_to_face, &r.sphere_to_face),
@@ -608,15 +608,16 @@ impl Report {
                     o.precision.name()
                 ));
             }
-            match o.values.unconverged_pairs {
+            match o.values.unconverged_rows {
                 Some(0) => notes.push(format!(
-                    "Tolerance mode ({}): every patch pair converged (estimate within the tolerance).",
+                    "Tolerance mode ({}): every row converged (each outer patch's summed estimate against a \
+                     face within the tolerance).",
                     o.precision.name()
                 )),
                 Some(n) => notes.push(format!(
-                    "NOT CONVERGED ({}): {n} patch pair(s) stopped above the tolerance (subdivision limit \
-                     or precision floor); their values are the best the settings allow and their \
-                     estimates are included above.",
+                    "NOT CONVERGED ({}): {n} row(s) (an outer patch against a face) stopped above the \
+                     tolerance (subdivision limit or precision floor); their values are the best the \
+                     settings allow and their estimates are included above.",
                     o.precision.name()
                 )),
                 None => {}

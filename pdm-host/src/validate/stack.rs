@@ -14,9 +14,9 @@
 
 use pdm_kernel::{Real, MAX_ORDER};
 
-/// The capacities the host instantiates (`CAP` of the match tables in `validate` and
-/// `tradeoff::engine`).
-pub const CAPACITIES: [usize; 6] = [25, 64, 144, 256, 576, MAX_ORDER * MAX_ORDER];
+/// The capacities the host instantiates: the kernel's [`pdm_kernel::with_capacity`] chooses
+/// among them.
+pub use pdm_kernel::CAPACITIES;
 
 /// `max_depth` of the tolerance mode in `pdm-ff validate` and `pdm-ff tradeoff`.
 pub const ADAPTIVE_MAX_DEPTH: u32 = 6;

@@ -23,7 +23,7 @@ use crate::vec3::{vec3, Vec3};
 /// let floor = BezierPatch::new(net)?;
 /// let ceiling = Parallelogram::new(vec3(0.0, 0.0, 1.0), vec3(0.0, 1.0, 0.0), vec3(1.0, 0.0, 0.0))?;
 /// let (a, b) = (Patch::whole(&floor)?, Patch::whole(&ceiling)?);
-/// let f = pair_exchange::<f64, _, _, _, 256>(&a, &b, PairSettings::ACCURATE, &())? / a.area(16)?;
+/// let f = pair_exchange::<f64, _, _, _, 256>(&a, &b, PairSettings::ACCURATE, &())?.value / a.area(16)?;
 /// assert!((f - 0.1998248956983874).abs() < 1e-13);
 /// # Ok::<(), pdm_kernel::PdmError>(())
 /// ```

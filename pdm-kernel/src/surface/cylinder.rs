@@ -19,7 +19,7 @@ use crate::vec3::Vec3;
 /// let base = Disk::new(vec3(0.0, 0.0, 0.0), vec3(0.0, 0.0, 1.0), 1.0)?;
 /// let wall = Cylinder::new(vec3(0.0, 0.0, 0.0), vec3(0.0, 0.0, 1.0), 1.0, 1.0, Side::Inner)?;
 /// let (a, b) = (Patch::whole(&base)?, Patch::whole(&wall)?);
-/// let f = pair_exchange::<f64, _, _, _, 256>(&a, &b, PairSettings::ACCURATE, &())? / a.area(16)?;
+/// let f = pair_exchange::<f64, _, _, _, 256>(&a, &b, PairSettings::ACCURATE, &())?.value / a.area(16)?;
 /// assert!((f - (1.0 - (3.0 - 5.0_f64.sqrt()) / 2.0)).abs() < 1e-13);
 /// # Ok::<(), pdm_kernel::PdmError>(())
 /// ```

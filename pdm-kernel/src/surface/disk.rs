@@ -17,11 +17,11 @@ use crate::vec3::Vec3;
 /// let lower = Disk::new(vec3(0.0, 0.0, 0.0), vec3(0.0, 0.0, 1.0), 1.0)?;
 /// let upper = Disk::new(vec3(0.0, 0.0, 1.0), vec3(0.0, 0.0, -1.0), 1.0)?;
 /// let (a, b) = (Patch::whole(&lower)?, Patch::whole(&upper)?);
-/// let f = pair_exchange::<f64, _, _, _, 256>(&a, &b, PairSettings::ACCURATE, &())? / a.area(16)?;
+/// let f = pair_exchange::<f64, _, _, _, 256>(&a, &b, PairSettings::ACCURATE, &())?.value / a.area(16)?;
 /// assert!((f - (3.0 - 5.0_f64.sqrt()) / 2.0).abs() < 1e-13);
 /// // Half of the lower disk (θ ∈ [0, π]) sees the upper one alike, by symmetry.
 /// let half = Patch::new(&lower, ParamRect::new(0.0, 1.0, 0.0, core::f64::consts::PI)?)?;
-/// let g = pair_exchange::<f64, _, _, _, 256>(&half, &b, PairSettings::ACCURATE, &())? / half.area(16)?;
+/// let g = pair_exchange::<f64, _, _, _, 256>(&half, &b, PairSettings::ACCURATE, &())?.value / half.area(16)?;
 /// assert!((g - f).abs() < 1e-13);
 /// # Ok::<(), pdm_kernel::PdmError>(())
 /// ```

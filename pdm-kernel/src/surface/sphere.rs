@@ -23,7 +23,7 @@ use crate::vec3::Vec3;
 /// let disk = Disk::new(vec3(0.0, 0.0, 0.0), vec3(0.0, 0.0, 1.0), 1.0)?;
 /// let (a, b) = (Patch::whole(&sphere)?, Patch::whole(&disk)?);
 /// let settings = PairSettings { order: 12, singular_order: 12, boundaries: true };
-/// let f = pair_exchange::<f64, _, _, _, 256>(&a, &b, settings, &())? / a.area(16)?;
+/// let f = pair_exchange::<f64, _, _, _, 256>(&a, &b, settings, &())?.value / a.area(16)?;
 /// assert!((f - 0.5 * (1.0 - 1.0 / 2.0_f64.sqrt())).abs() < 1e-12);
 /// # Ok::<(), pdm_kernel::PdmError>(())
 /// ```

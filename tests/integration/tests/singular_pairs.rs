@@ -28,7 +28,7 @@ fn grid_factor<T: Real, SA: Surface<T>, SB: Surface<T>>(
     for pa in a {
         area += PatchSamples::<T, 1024>::new(&pa, settings.order).unwrap().area().to_f64();
         for pb in b.clone() {
-            exchange += pair_exchange::<T, _, _, _, 1024>(&pa, &pb, settings, &()).unwrap().to_f64();
+            exchange += pair_exchange::<T, _, _, _, 1024>(&pa, &pb, settings, &()).unwrap().value.to_f64();
         }
     }
     exchange / area
