@@ -6,16 +6,21 @@
 //!
 //! # Multi-precision approach
 //!
-//! Every quantity the computation touches has a magnitude known in advance: nodes lie in [−1, 1],
-//! |Pⱼ(x)| ≤ 1 there, the Newton corrections are small and the weights lie in (0, 2]. So instead of
-//! a floating-point multi-precision type, all values are **binary fixed point**: a real number x is
-//! held as the exact integer `raw = x · 2^bits` in a [`dashu_int::IBig`] (pure Rust, no C library),
-//! with [`FRAC_BITS`] = 320 fractional bits by default. Each multiplication or division truncates
-//! once, by less than 2^−bits, so the error analysis is plain integer bookkeeping; there is no
-//! precision context to get wrong. Double-double (~106 bits) would be too short to check the
-//! reference to 1e−40 and quad-double would need a hand-written and separately tested library, while
-//! a 320-bit fixed point on a well-tested big-integer crate costs a few lines and runs in tens of
-//! milliseconds even in a debug build.
+//! Every value is a binary [`dashu_float::FBig`] ([`Float`]) with a [`PRECISION`] = 320-bit
+//! significand, each operation rounded to nearest (ties to even). Every quantity the computation
+//! touches has a magnitude known in advance: nodes lie in [−1, 1], |Pⱼ(x)| ≤ 1 there, the Newton
+//! corrections are small and the weights lie in (0, 2]; so each operation errs by less than
+//! 2^−319 absolute, and the error analysis is that of a 320-bit fixed point. This generator used
+//! such a fixed point before, on `dashu-int` integers with hand-written rounding to f64 and f32;
+//! it gave the same tables byte for byte and ran faster (all the tables: 10 ms against 30 ms in
+//! a release build, 100 ms against 210 ms in a debug one), a difference that does not matter here.
+//!
+//! One rule of `dashu-float` needs care: an operation takes the larger precision of its operands,
+//! and an exact value (precision 0, "unlimited") counts as the smaller one, so an exact value
+//! combined with a 320-bit one is rounded to 320 bits, and combined with a 1-bit constant such as
+//! `2^−256` built by `FBig::from_parts`, to 1 bit. Every iterate here carries 320 bits; the
+//! constants and the values compared or rounded exactly are made exact ([`exact`], [`pow2`])
+//! first.
 //!
 //! Each value is claimed accurate to 2^(−bits + [`ERROR_BOUND_BITS`]) = 2^−256 absolute (the actual
 //! error is below 2^−300; the tests check it against a computation with 128 more bits, and check
@@ -25,32 +30,38 @@
 //!
 //! For order n the ⌊n/2⌋ positive roots of Pₙ are found by Newton iteration on the three-term
 //! recurrence (k+1)Pₖ₊₁ = (2k+1)x Pₖ − k Pₖ₋₁ with Pₙ′(x) = n(x Pₙ − Pₙ₋₁)/(x² − 1): starting from
-//! cos(π(k + ¾)/(n + ½)), first in f64, then in fixed point until the correction is below the
-//! working precision. The weights are wₖ = 2(1 − xₖ²)/(n Pₙ₋₁(xₖ))². Only the nonnegative nodes are
-//! computed; the negative half is their exact mirror, so node k is −node (n−1−k) and the weights are
-//! symmetric bit for bit, and the middle node of an odd order is exactly 0.
+//! cos(π(k + ¾)/(n + ½)), first in f64, then in multi-precision until the correction is below the
+//! working precision. The weights are wₖ = 2(1 − xₖ²)/(n Pₙ₋₁(xₖ))². Only the nonnegative nodes
+//! are computed; the negative half is their exact mirror, so node k is −node (n−1−k) and the
+//! weights are symmetric bit for bit, and the middle node of an odd order is exactly 0.
 //!
 //! # Rounding
 //!
-//! [`round_to_f64`] and [`round_to_f32`] round the fixed-point value **directly** to nearest
-//! (ties to even) in the target format — f32 is never obtained by rounding the f64 value again,
-//! which would double-round. Since the high-precision value is itself an approximation, a rounding
-//! is accepted only if the value is farther than the error bound from the rounding midpoint (Ziv's
+//! [`round_to_f64`] and [`round_to_f32`] round **directly** to nearest (ties to even) in the target
+//! format, by `FBig::to_f64` and `FBig::to_f32` — f32 is never obtained by rounding the f64 value
+//! again, which would double-round. Since the high-precision value is itself an approximation, a
+//! rounding is accepted only if the value minus and plus the error bound round alike (Ziv's
 //! test); otherwise generation fails with [`GenError::AmbiguousRounding`] instead of guessing.
 
 use std::fmt::{self, Write as _};
 use std::path::{Path, PathBuf};
 
-use dashu_int::ops::{BitTest, UnsignedAbs};
-use dashu_int::{IBig, UBig};
+use dashu_float::round::mode::HalfEven;
+use dashu_float::FBig;
+use dashu_int::ops::Abs;
+use dashu_int::IBig;
+
+/// A binary multi-precision float rounded to nearest, ties to even.
+pub type Float = FBig<HalfEven>;
 
 /// The largest order generated (must match the kernel's `MAX_ORDER`).
 pub const MAX_ORDER: usize = 32;
 
-/// Default number of fractional bits of the fixed-point reference values.
-pub const FRAC_BITS: usize = 320;
+/// Default number of significand bits of the reference values.
+pub const PRECISION: usize = 320;
 
-/// Claimed accuracy of every reference value: |error| < 2^ERROR_BOUND_BITS units of 2^−bits.
+/// Claimed accuracy of every reference value computed with `bits` significand bits: |error| <
+/// 2^(ERROR_BOUND_BITS − bits) absolute.
 pub const ERROR_BOUND_BITS: usize = 64;
 
 /// First line of the generated file.
@@ -62,9 +73,9 @@ pub const TABLE_LEN: usize = MAX_ORDER * (MAX_ORDER + 1) / 2;
 /// Why the tables could not be generated.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum GenError {
-    /// Order 0 or an order too large for the fixed-point range.
+    /// Order 0 or an order above 64.
     UnsupportedOrder(usize),
-    /// The fractional precision is too small for the claimed error bound.
+    /// The precision is too small for the claimed error bound.
     PrecisionTooLow(usize),
     /// Newton's iteration did not converge for this positive root (0 = largest).
     NoConvergence {
@@ -94,7 +105,7 @@ impl fmt::Display for GenError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Self::UnsupportedOrder(n) => write!(f, "unsupported Gauss–Legendre order {n}"),
-            Self::PrecisionTooLow(b) => write!(f, "{b} fractional bits are too few"),
+            Self::PrecisionTooLow(b) => write!(f, "{b} significand bits are too few"),
             Self::NoConvergence { order, root } => {
                 write!(f, "Newton iteration did not converge (order {order}, positive root {root})")
             }
@@ -110,15 +121,15 @@ impl fmt::Display for GenError {
 
 impl std::error::Error for GenError {}
 
-/// A Gauss–Legendre rule in fixed point: each value is `raw · 2^−frac_bits`.
+/// A Gauss–Legendre rule in multi-precision.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct HpRule {
-    /// Number of fractional bits of every raw value.
-    pub frac_bits: usize,
+    /// Number of significand bits the rule was computed with.
+    pub precision: usize,
     /// Nodes, ascending, exactly mirror-symmetric.
-    pub nodes: Vec<IBig>,
+    pub nodes: Vec<Float>,
     /// Weights, mirror-symmetric.
-    pub weights: Vec<IBig>,
+    pub weights: Vec<Float>,
 }
 
 /// The generated tables, as they are written to the kernel.
@@ -136,81 +147,71 @@ pub struct Tables {
     pub weights_f32: Vec<f32>,
 }
 
-fn ibig(v: usize) -> IBig {
-    IBig::from(v)
-}
-
-/// Fixed-point product, truncated towards −∞ (error < 1 unit).
-fn fx_mul(a: &IBig, b: &IBig, bits: usize) -> IBig {
-    (a * b) >> bits
-}
-
-/// Fixed-point quotient, truncated towards 0 (error < 1 unit).
-fn fx_div(a: &IBig, b: &IBig, bits: usize) -> IBig {
-    (a << bits) / b
-}
-
-/// The exact fixed-point value of a finite f64, or `None` if it has bits below 2^−bits.
+/// `v` with unlimited precision (the same value): operations between exact values are exact.
 #[must_use]
-pub fn fixed_from_f64(x: f64, bits: usize) -> Option<IBig> {
-    if !x.is_finite() {
-        return None;
-    }
-    if x == 0.0 {
-        return Some(IBig::ZERO);
-    }
-    let raw = x.to_bits();
-    let biased = i64::try_from((raw >> 52) & 0x7ff).ok()?;
-    let frac = raw & ((1_u64 << 52) - 1);
-    let (mant, exp) = if biased == 0 { (frac, -1074) } else { (frac | (1_u64 << 52), biased - 1075) };
-    let mag = IBig::from(mant);
-    let shift = exp + i64::try_from(bits).ok()?;
-    let value = if shift >= 0 {
-        mag << usize::try_from(shift).ok()?
+pub fn exact(v: &Float) -> Float {
+    v.clone().with_precision(0).value()
+}
+
+/// 2^e, exact.
+#[must_use]
+pub fn pow2(e: isize) -> Float {
+    exact(&Float::from_parts(IBig::ONE, e))
+}
+
+/// A finite f64, exact; `None` for NaN and infinities.
+#[must_use]
+pub fn exact_f64(x: f64) -> Option<Float> {
+    if x.is_finite() {
+        Float::try_from(x).ok().map(|v| exact(&v))
     } else {
-        let s = usize::try_from(-shift).ok()?;
-        let v = &mag >> s;
-        if (&v << s) != mag {
-            return None;
-        }
-        v
-    };
-    Some(if x < 0.0 { -value } else { value })
+        None
+    }
 }
 
-/// The exact fixed-point value of a finite f32, or `None` if it has bits below 2^−bits.
+/// A finite f32, exact; `None` for NaN and infinities.
 #[must_use]
-pub fn fixed_from_f32(x: f32, bits: usize) -> Option<IBig> {
-    fixed_from_f64(f64::from(x), bits)
+pub fn exact_f32(x: f32) -> Option<Float> {
+    exact_f64(f64::from(x))
 }
 
-/// (Pₙ(x), Pₙ₋₁(x)) in fixed point, n ≥ 1, |x| ≤ 1.
-fn legendre_pair(n: usize, x: &IBig, bits: usize) -> (IBig, IBig) {
-    let mut prev = IBig::ONE << bits; // P_0
+/// `raw · 2^−bits`, exact (a fixed-point value, as the tests build them).
+#[must_use]
+pub fn from_fixed(raw: IBig, bits: usize) -> Float {
+    exact(&Float::from_parts(raw, -isize::try_from(bits).unwrap_or(isize::MAX)))
+}
+
+/// `v · 2^bits` rounded to the nearest integer (ties to even): the fixed-point value with `bits`
+/// fractional bits, for checks in integer arithmetic.
+#[must_use]
+pub fn to_fixed(v: &Float, bits: usize) -> IBig {
+    (exact(v) * pow2(isize::try_from(bits).unwrap_or(isize::MAX))).to_int().value()
+}
+
+/// (Pₙ(x), Pₙ₋₁(x)), n ≥ 1, at the precision of `x`.
+fn legendre_pair(n: usize, x: &Float) -> (Float, Float) {
+    let mut prev = Float::ONE; // P_0 (exact)
     let mut cur = x.clone(); // P_1
     for k in 1..n {
-        // P_{k+1} = ((2k+1) x P_k − k P_{k−1}) / (k+1), with a single truncation.
-        let num = ibig(2 * k + 1) * (x * &cur) - ibig(k) * (&prev << bits);
-        let next = num / (ibig(k + 1) << bits);
+        // P_{k+1} = ((2k+1) x P_k − k P_{k−1}) / (k+1)
+        let next = ((x * &cur) * (2 * k + 1) - &prev * k) / (k + 1);
         prev = std::mem::replace(&mut cur, next);
     }
     (cur, prev)
 }
 
-/// The Newton correction Pₙ(x)/Pₙ′(x) in fixed point.
-fn newton_step(n: usize, x: &IBig, bits: usize) -> Option<IBig> {
-    let (pn, pn1) = legendre_pair(n, x, bits);
-    let one = IBig::ONE << bits;
-    let num = ibig(n) * (fx_mul(x, &pn, bits) - pn1);
-    let den = fx_mul(x, x, bits) - one;
-    if den == IBig::ZERO {
+/// The Newton correction Pₙ(x)/Pₙ′(x), at the precision of `x`.
+fn newton_step(n: usize, x: &Float) -> Option<Float> {
+    let (pn, pn1) = legendre_pair(n, x);
+    let den = x.sqr() - Float::ONE;
+    if den.repr().significand().is_zero() {
         return None;
     }
-    let dp = fx_div(&num, &den, bits);
-    if dp == IBig::ZERO {
+    let dp = ((x * &pn - pn1) * n) / den;
+    if dp.repr().significand().is_zero() {
         return None;
     }
-    Some(fx_div(&pn, &dp, bits))
+    Some(pn / dp)
 }
 
 /// The positive root of Pₙ with index `root` (0 = largest), first refined in f64.
@@ -234,7 +235,7 @@ fn f64_guess(n: usize, root: usize) -> f64 {
     x
 }
 
-/// The n-point Gauss–Legendre rule with `bits` fractional bits (nodes ascending).
+/// The n-point Gauss–Legendre rule with `bits` significand bits (nodes ascending).
 ///
 /// # Errors
 /// [`GenError`] if the order is 0 or above 64, the precision is too low for the error bound, or
@@ -243,148 +244,118 @@ pub fn hp_rule_with_bits(n: usize, bits: usize) -> Result<HpRule, GenError> {
     if n == 0 || n > 64 {
         return Err(GenError::UnsupportedOrder(n));
     }
+    let b = isize::try_from(bits).map_err(|_| GenError::PrecisionTooLow(bits))?;
     if bits < 2 * ERROR_BOUND_BITS + 64 {
         return Err(GenError::PrecisionTooLow(bits));
     }
-    let one = IBig::ONE << bits;
-    // Converged once the last correction is below 2^(bits/2 − 16) units: one more step then
-    // squares the error far below one unit.
-    let small = UBig::ONE << (bits / 2 - 16);
-    let tiny = UBig::ONE << 16;
+    // Converged once the last correction is below 2^(bits/2 − 16 − bits): one more step then
+    // squares the error far below the working precision.
+    let small = pow2(b / 2 - 16 - b);
+    let tiny = pow2(16 - b);
 
-    let mut positive: Vec<IBig> = Vec::with_capacity(n / 2);
+    let mut positive: Vec<Float> = Vec::with_capacity(n / 2);
     for root in 0..n / 2 {
-        let guess = f64_guess(n, root);
-        let mut x = fixed_from_f64(guess, bits).ok_or(GenError::NoConvergence { order: n, root })?;
+        let no_convergence = GenError::NoConvergence { order: n, root };
+        let guess = Float::try_from(f64_guess(n, root)).map_err(|_| no_convergence.clone())?;
+        // The working precision: every iterate, and so every operation, carries `bits` bits.
+        let mut x = guess.with_precision(bits).value();
         let mut converged = false;
         for _ in 0..16 {
-            let dx = newton_step(n, &x, bits).ok_or(GenError::NoConvergence { order: n, root })?;
+            let dx = newton_step(n, &x).ok_or_else(|| no_convergence.clone())?;
             x -= &dx;
-            let step = dx.unsigned_abs();
+            let step = exact(&dx).abs();
             if step < tiny {
                 converged = true;
                 break;
             }
             if step < small {
                 // Quadratic convergence: one more step lands below the working precision.
-                let last = newton_step(n, &x, bits).ok_or(GenError::NoConvergence { order: n, root })?;
+                let last = newton_step(n, &x).ok_or_else(|| no_convergence.clone())?;
                 x -= &last;
-                converged = last.unsigned_abs() < tiny;
+                converged = exact(&last).abs() < tiny;
                 break;
             }
         }
         if !converged {
-            return Err(GenError::NoConvergence { order: n, root });
+            return Err(no_convergence);
         }
         positive.push(x);
     }
 
     // Strictly decreasing inside (0, 1), separated by far more than the error bound: then the
     // ⌊n/2⌋ roots found are distinct, hence all the positive roots of Pₙ.
-    let gap = IBig::ONE << (ERROR_BOUND_BITS + 8);
-    let mut upper = one.clone();
+    let gap = pow2(isize::try_from(ERROR_BOUND_BITS).unwrap_or(0) + 8 - b);
+    let mut upper = Float::ONE;
     for x in &positive {
-        if &upper - x <= gap || x <= &gap {
+        let x = exact(x);
+        if &upper - &x <= gap || x <= gap {
             return Err(GenError::RootsNotSeparated { order: n });
         }
-        upper = x.clone();
+        upper = x;
     }
 
     let mut half_nodes = positive; // descending, x ≥ 0
     if n % 2 == 1 {
-        half_nodes.push(IBig::ZERO);
+        half_nodes.push(Float::ZERO.with_precision(bits).value());
     }
-    let half_weights: Vec<IBig> = half_nodes
+    let half_weights: Vec<Float> = half_nodes
         .iter()
         .map(|x| {
-            // w = 2 (1 − x²) / (n Pₙ₋₁(x))²
-            let (_, pn1) = legendre_pair(n, x, bits);
-            let num = (&one - fx_mul(x, x, bits)) << 1;
-            let d = ibig(n) * pn1;
-            fx_div(&num, &fx_mul(&d, &d, bits), bits)
+            // w = 2 (1 − x²) / (n Pₙ₋₁(x))², at the precision of x
+            let (_, pn1) = legendre_pair(n, x);
+            let d = pn1 * n;
+            ((Float::ONE - x.sqr()) * 2_u8) / d.sqr()
         })
         .collect();
 
     // Ascending: the mirrored negative nodes (largest magnitude first), then the nonnegative ones.
     let mirrored = n / 2;
-    let nodes: Vec<IBig> =
-        half_nodes.iter().take(mirrored).map(|x| -x).chain(half_nodes.iter().rev().cloned()).collect();
-    let weights: Vec<IBig> =
+    let nodes: Vec<Float> =
+        half_nodes.iter().take(mirrored).map(|x| -x.clone()).chain(half_nodes.iter().rev().cloned()).collect();
+    let weights: Vec<Float> =
         half_weights.iter().take(mirrored).cloned().chain(half_weights.iter().rev().cloned()).collect();
-    Ok(HpRule { frac_bits: bits, nodes, weights })
+    Ok(HpRule { precision: bits, nodes, weights })
 }
 
-/// The n-point rule at the default precision [`FRAC_BITS`].
+/// The n-point rule at the default precision [`PRECISION`].
 ///
 /// # Errors
 /// See [`hp_rule_with_bits`].
 pub fn hp_rule(n: usize) -> Result<HpRule, GenError> {
-    hp_rule_with_bits(n, FRAC_BITS)
+    hp_rule_with_bits(n, PRECISION)
 }
 
-/// Rounds `raw · 2^−bits` to nearest with `precision` significant bits: `(negative, q, e)` with the
-/// rounded value ±q·2^e and 2^(precision−1) ≤ q < 2^precision (or q = 0 for an exact zero).
-/// `None` if the value lies within the error bound of a midpoint or is too small to round safely.
-fn round_significand(raw: &IBig, bits: usize, precision: usize) -> Option<(bool, u64, i64)> {
-    if *raw == IBig::ZERO {
-        return Some((false, 0, 0));
-    }
-    let negative = *raw < IBig::ZERO;
-    let mag: UBig = raw.unsigned_abs();
-    let len = mag.bit_len();
-    if len <= precision + ERROR_BOUND_BITS + 2 {
-        return None;
-    }
-    let shift = len - precision;
-    let (low, high) = mag.split_bits(shift);
-    let half = UBig::ONE << (shift - 1);
-    let dist = if low > half { &low - &half } else { &half - &low };
-    if dist <= (UBig::ONE << ERROR_BOUND_BITS) {
-        return None; // Ziv: cannot decide the rounding direction with certainty
-    }
-    let mut q = u64::try_from(&high).ok()?;
-    if low > half {
-        q += 1;
-    }
-    let mut exp = i64::try_from(shift).ok()? - i64::try_from(bits).ok()?;
-    if q == 1_u64 << precision {
-        q >>= 1;
-        exp += 1;
-    }
-    Some((negative, q, exp))
+/// `v ∓ 2^(ERROR_BOUND_BITS − bits)`, exact: the interval the true value lies in.
+fn error_interval(v: &Float, bits: usize) -> (Float, Float) {
+    let e = pow2(isize::try_from(ERROR_BOUND_BITS).unwrap_or(0) - isize::try_from(bits).unwrap_or(isize::MAX));
+    let v = exact(v);
+    (&v - &e, &v + &e)
 }
 
-/// `raw · 2^−bits` correctly rounded (to nearest, ties to even) to f64; `None` if undecidable within
-/// the error bound [`ERROR_BOUND_BITS`] or outside the normal range.
+/// `v` (computed with `bits` significand bits) correctly rounded (to nearest, ties to even) to
+/// f64; `None` if undecidable within the error bound [`ERROR_BOUND_BITS`] or not finite. An exact
+/// zero is +0.
 #[must_use]
-pub fn round_to_f64(raw: &IBig, bits: usize) -> Option<f64> {
-    let (negative, q, exp) = round_significand(raw, bits, 53)?;
-    if q == 0 {
+pub fn round_to_f64(v: &Float, bits: usize) -> Option<f64> {
+    if v.repr().significand().is_zero() {
         return Some(0.0);
     }
-    let biased = u64::try_from(exp + 52 + 1023).ok()?;
-    if !(1..=2046).contains(&biased) {
-        return None;
-    }
-    let sign = if negative { 1_u64 << 63 } else { 0 };
-    Some(f64::from_bits(sign | (biased << 52) | (q & ((1_u64 << 52) - 1))))
+    let (lo, hi) = error_interval(v, bits);
+    let (a, b) = (lo.to_f64().value(), hi.to_f64().value());
+    (a.to_bits() == b.to_bits() && a.is_finite() && a != 0.0).then_some(a)
 }
 
-/// `raw · 2^−bits` correctly rounded (to nearest, ties to even) **directly** to f32; `None` if
-/// undecidable within the error bound [`ERROR_BOUND_BITS`] or outside the normal range.
+/// `v` (computed with `bits` significand bits) correctly rounded (to nearest, ties to even)
+/// **directly** to f32; `None` if undecidable within the error bound [`ERROR_BOUND_BITS`] or not
+/// finite. An exact zero is +0.
 #[must_use]
-pub fn round_to_f32(raw: &IBig, bits: usize) -> Option<f32> {
-    let (negative, q, exp) = round_significand(raw, bits, 24)?;
-    if q == 0 {
+pub fn round_to_f32(v: &Float, bits: usize) -> Option<f32> {
+    if v.repr().significand().is_zero() {
         return Some(0.0);
     }
-    let biased = u32::try_from(exp + 23 + 127).ok()?;
-    if !(1..=254).contains(&biased) {
-        return None;
-    }
-    let q = u32::try_from(q).ok()?;
-    let sign = if negative { 1_u32 << 31 } else { 0 };
-    Some(f32::from_bits(sign | (biased << 23) | (q & ((1_u32 << 23) - 1))))
+    let (lo, hi) = error_interval(v, bits);
+    let (a, b) = (lo.to_f32().value(), hi.to_f32().value());
+    (a.to_bits() == b.to_bits() && a.is_finite() && a != 0.0).then_some(a)
 }
 
 /// The rounded tables for orders 1..=[`MAX_ORDER`].
@@ -401,7 +372,7 @@ pub fn tables() -> Result<Tables, GenError> {
     };
     for n in 1..=MAX_ORDER {
         let rule = hp_rule(n)?;
-        let bits = rule.frac_bits;
+        let bits = rule.precision;
         for (index, (x, w)) in rule.nodes.iter().zip(&rule.weights).enumerate() {
             let err = |what| GenError::AmbiguousRounding { order: n, index, what };
             t.nodes_f64.push(round_to_f64(x, bits).ok_or_else(|| err("node (f64)"))?);

@@ -2,7 +2,8 @@
 //! computations that share no code with the kernel's quadrature.
 //!
 //! Nothing here uses `pdm_kernel`: plain `f64`, own vector helpers ([`vector`]) and own
-//! quadrature rules ([`quadrature`], Gauss–Legendre nodes by Newton iteration).
+//! quadrature rules ([`quadrature`]: Gauss–Legendre nodes and weights from the `gauss-quad`
+//! crate, the graded and adaptive rules written here).
 //! * [`closed_form`]: catalogue entries C-11, C-14, C-41, sphere identities.
 //! * [`contour`]: planar polygon → planar polygon by the contour (Stokes) form.
 //! * [`monte_carlo`]: seeded, multithreaded ray estimator for the paper's cube-and-sphere scene.
