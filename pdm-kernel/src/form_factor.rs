@@ -51,6 +51,19 @@ impl Quadrature {
 
 /// The exchange integral A_a·F_{a→b} = (1/π) ∫∫ cos α_a cos α_b / L² dA_b dA_a, i.e. eq. (15) times A_a,
 /// which is symmetric in a and b (reciprocity). Not divided by the area, so it adds over patches.
+///
+/// ```
+/// use pdm_kernel::{exchange, vec3, Parallelogram, Patch, PatchSamples};
+/// // Unit squares facing each other at distance 1 (C-11: F = 0.1998248956983874, A = 1),
+/// // sampled once at order 16 and summed by eq. (16) in both directions.
+/// let lower = Parallelogram::new(vec3(0.0, 0.0, 0.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0))?;
+/// let upper = Parallelogram::new(vec3(0.0, 0.0, 1.0), vec3(0.0, 1.0, 0.0), vec3(1.0, 0.0, 0.0))?;
+/// let a = PatchSamples::<f64, 256>::new(&Patch::whole(&lower)?, 16)?;
+/// let b = PatchSamples::<f64, 256>::new(&Patch::whole(&upper)?, 16)?;
+/// let (ab, ba) = (exchange(&a, &b, &())?, exchange(&b, &a, &())?);
+/// assert!((ab - 0.1998248956983874).abs() < 1e-12 && (ab - ba).abs() < 1e-14);
+/// # Ok::<(), pdm_kernel::PdmError>(())
+/// ```
 pub fn exchange<T, O, const CA: usize, const CB: usize>(
     a: &PatchSamples<T, CA>,
     b: &PatchSamples<T, CB>,
@@ -98,6 +111,22 @@ where
 
 /// F_{a→b} between two sampled patches by eqs. (15)–(16) with the 1/π and Jacobians restored,
 /// with the curvature tests and `occluders`. `Err(InvalidResult)` if the sum is not finite.
+///
+/// ```
+/// use pdm_kernel::{form_factor, vec3, Parallelogram, Patch, PatchSamples, Sphere};
+/// // A 2 × 2 square 1 below a 1 × 1 square, centred, facing it (catalogue C-11 generalised:
+/// // the bigger one's view of the smaller is A_small/A_big times the other's).
+/// let big = Parallelogram::new(vec3(-1.0, -1.0, 0.0), vec3(2.0, 0.0, 0.0), vec3(0.0, 2.0, 0.0))?;
+/// let small = Parallelogram::new(vec3(-0.5, -0.5, 1.0), vec3(0.0, 1.0, 0.0), vec3(1.0, 0.0, 0.0))?;
+/// let a = PatchSamples::<f64, 256>::new(&Patch::whole(&big)?, 16)?;
+/// let b = PatchSamples::<f64, 256>::new(&Patch::whole(&small)?, 16)?;
+/// let (ab, ba) = (form_factor(&a, &b, &())?, form_factor(&b, &a, &())?);
+/// assert!((4.0 * ab - ba).abs() < 1e-13); // reciprocity: A_a F_ab = A_b F_ba
+/// // A ball between them hides part of the view.
+/// let ball = Sphere::outer(vec3(0.0, 0.0, 0.5), 0.2)?;
+/// assert!(form_factor(&a, &b, &ball)? < ab);
+/// # Ok::<(), pdm_kernel::PdmError>(())
+/// ```
 pub fn form_factor<T, O, const CA: usize, const CB: usize>(
     a: &PatchSamples<T, CA>,
     b: &PatchSamples<T, CB>,
@@ -249,6 +278,18 @@ pub(crate) fn samples_resolved<T: Real, const CA: usize, const CB: usize>(
 /// diagonal makes it converge only algebraically (≈ p^−1.3 on a tube's inside);
 /// [`crate::pair_exchange`] with the patch twice uses the identical-panel transform instead,
 /// which converges exponentially. Needs `order + 1 ≤ MAX_ORDER` and `CAP ≥ (order + 1)²`.
+///
+/// ```
+/// use pdm_kernel::{self_form_factor, vec3, ParamRect, Patch, Sphere};
+/// use core::f64::consts::PI;
+/// // Inside a sphere every element sees any area A in the fraction A / (4πR²): a patch of the
+/// // inside of a unit sphere sees itself in the fraction of the sphere it covers.
+/// let sphere = Sphere::inner(vec3(0.0, 0.0, 0.0), 1.0)?;
+/// let patch = Patch::new(&sphere, ParamRect { t0: 0.0, t1: 1.0, s0: 0.0, s1: 2.0 })?;
+/// let f = self_form_factor::<f64, _, _, 256>(&patch, 12, &())?;
+/// assert!((f - patch.area(16)? / (4.0 * PI)).abs() < 1e-12);
+/// # Ok::<(), pdm_kernel::PdmError>(())
+/// ```
 pub fn self_form_factor<T, S, O, const CAP: usize>(
     patch: &Patch<'_, T, S>,
     order: usize,
@@ -287,6 +328,18 @@ where
 /// spacings), divided by A_A, the sum of the patch areas by eq. (12) with the same rule's
 /// weights (so that a surface's factors to a closed enclosure sum to 1 up to the quadrature
 /// error). Every patch is re-sampled for each pair; nothing is allocated.
+///
+/// ```
+/// use pdm_kernel::{surface_form_factor, vec3, Parallelogram, PatchGrid, Quadrature};
+/// // Perpendicular unit squares sharing an edge (C-14: 0.2000437760754...), each cut 2 × 2:
+/// // the pairs along the shared edge go to the shared-edge transform, the others to the sum.
+/// let floor = Parallelogram::new(vec3(0.0, 0.0, 0.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0))?;
+/// let wall = Parallelogram::new(vec3(0.0, 0.0, 0.0), vec3(0.0, 0.0, 1.0), vec3(1.0, 0.0, 0.0))?;
+/// let (a, b) = (PatchGrid::new(&floor, 2, 2)?, PatchGrid::new(&wall, 2, 2)?);
+/// let f = surface_form_factor::<f64, _, _, _, 256>(a, b, Quadrature::uniform(12), &())?;
+/// assert!((f - 0.20004377607540316).abs() < 1e-9);
+/// # Ok::<(), pdm_kernel::PdmError>(())
+/// ```
 pub fn surface_form_factor<T, SA, SB, O, const CAP: usize>(
     a: PatchGrid<'_, T, SA>,
     b: PatchGrid<'_, T, SB>,

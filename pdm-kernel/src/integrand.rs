@@ -20,6 +20,17 @@ use crate::visibility::Occluder;
 
 /// The two-sided curvature test of sections 3.1–3.2: `true` iff n_a·(p_b − p_a) > 0 and
 /// n_b·(p_a − p_b) > 0.
+///
+/// ```
+/// use pdm_kernel::{mutually_facing, vec3};
+/// let (up, down) = (vec3(0.0, 0.0, 1.0), vec3(0.0, 0.0, -1.0));
+/// // A floor point and a ceiling point above it face each other...
+/// assert!(mutually_facing(vec3(0.0, 0.0, 0.0), up, vec3(0.3, 0.0, 1.0), down));
+/// // ...but not when the ceiling's normal points up, away from the floor,
+/// assert!(!mutually_facing(vec3(0.0, 0.0, 0.0), up, vec3(0.3, 0.0, 1.0), up));
+/// // nor two points of one plane (grazing: the cosines are zero).
+/// assert!(!mutually_facing(vec3(0.0, 0.0, 0.0), up, vec3(1.0, 0.0, 0.0), up));
+/// ```
 #[inline(always)]
 #[must_use]
 pub fn mutually_facing<T: Real>(p_a: Vec3<T>, n_a: Vec3<T>, p_b: Vec3<T>, n_b: Vec3<T>) -> bool {
