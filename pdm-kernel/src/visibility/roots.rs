@@ -1,0 +1,107 @@
+//! Root finding for the occlusion tests: real roots of quadratics without cancellation, the
+//! crossings of a segment with a quadric surface (end points on the surface deflated exactly),
+//! and the polynomials along a line that the closed-form visibility boundaries solve.
+
+use super::*;
+
+/// Passes the real roots of a·τ² + b·τ + c (a linear or constant polynomial included) to
+/// `out`, in a cancellation-free form; a double root is passed once, non-finite roots never.
+pub(crate) fn polynomial_roots<T: Real>(a: T, b: T, c: T, out: &mut dyn FnMut(T)) {
+    let mut emit = |x: T| {
+        if x.is_finite() {
+            out(x);
+        }
+    };
+    if a == T::ZERO {
+        if b != T::ZERO {
+            emit(-c / b);
+        }
+        return;
+    }
+    let disc = b * b - T::TWO * T::TWO * a * c;
+    if disc < T::ZERO {
+        return;
+    }
+    let q = if b >= T::ZERO { -(b + disc.sqrt()) * T::HALF } else { (disc.sqrt() - b) * T::HALF };
+    if q == T::ZERO {
+        emit(T::ZERO);
+        return;
+    }
+    emit(q / a);
+    if disc > T::ZERO {
+        emit(c / q);
+    }
+}
+
+/// (m·w)² − k·|w|² along w(τ) = w₀ + τ·d, as the coefficients (a, b, c) of a τ² + b τ + c
+/// (zero where w lies on the cone of directions from p tangent to a sphere, k = |m|² − R²).
+#[cfg(feature = "closed-form")]
+#[inline]
+pub(super) fn cone_polynomial<T: Real>(m: Vec3<T>, k: T, w0: Vec3<T>, d: Vec3<T>) -> (T, T, T) {
+    let (md, mw) = (m.dot(d), m.dot(w0));
+    (md * md - k * d.norm2(), T::TWO * (md * mw - k * d.dot(w0)), mw * mw - k * w0.norm2())
+}
+
+/// |x(τ) − c|² − r² for x(τ) = x₀ + τ·d, as (a, b, c).
+#[cfg(feature = "closed-form")]
+#[inline]
+pub(super) fn sphere_polynomial<T: Real>(x0: Vec3<T>, d: Vec3<T>, center: Vec3<T>, r: T) -> (T, T, T) {
+    let f = x0 - center;
+    (d.norm2(), T::TWO * f.dot(d), f.norm2() - r * r)
+}
+
+/// Roots of a τ² + 2 b τ + c = 0 (a > 0), in a numerically stable form; `None` if none are real
+/// or the segment only grazes (double root).
+#[inline]
+pub(super) fn quadratic_roots<T: Real>(a: T, b: T, c: T) -> Option<(T, T)> {
+    let disc = b * b - a * c;
+    if !(disc > T::ZERO) || !(a > T::ZERO) {
+        return None;
+    }
+    let sq = disc.sqrt();
+    let q = if b >= T::ZERO { -(b + sq) } else { -b + sq };
+    if q == T::ZERO {
+        return Some((T::ZERO, T::ZERO));
+    }
+    Some((q / a, c / q))
+}
+
+/// Whether the segment crosses a quadric surface f(τ) = a τ² + 2 b τ + c_p with f(1) = c_q,
+/// at an interior τ accepted by `accept`. An end point lying on the surface (|c| within
+/// rounding, [`on_surface`]) is a root τ = 0 or 1 *exactly*: the other root then follows from
+/// Vieta's formulas, so rounding in c never creates a spurious crossing next to an end point
+/// (which for short chords in f32 would otherwise exceed any fixed τ tolerance).
+#[inline]
+pub(super) fn crossing_of_quadric<T: Real>(a: T, b: T, c_p: T, c_q: T, scale: T, accept: impl Fn(T) -> bool) -> bool {
+    if !(a > T::ZERO) {
+        return false;
+    }
+    let p_on = on_surface(c_p, scale);
+    let q_on = on_surface(c_q, scale);
+    match (p_on, q_on) {
+        // A chord between two points of the surface: it meets the surface only at its ends.
+        (true, true) => false,
+        // Roots 0 and −2b/a.
+        (true, false) => {
+            let t = -T::TWO * b / a;
+            interior(t) && accept(t)
+        }
+        // Roots 1 and c_p/a (product of the roots).
+        (false, true) => {
+            let t = c_p / a;
+            interior(t) && accept(t)
+        }
+        (false, false) => match quadratic_roots(a, b, c_p) {
+            Some((t1, t2)) => (interior(t1) && accept(t1)) || (interior(t2) && accept(t2)),
+            None => false,
+        },
+    }
+}
+
+/// `true` if a quadric's value `c` at a point is zero up to the rounding of evaluating it at
+/// that scale (`scale` ≈ R²) — and up to the error of the elementary functions that placed the
+/// point ([`Real::ELEMENTARY_ERROR`], large with micromath): the point lies on the surface.
+#[inline(always)]
+pub(super) fn on_surface<T: Real>(c: T, scale: T) -> bool {
+    c.abs() <= (T::from_f64(64.0) * T::EPSILON + T::from_f64(16.0) * T::ELEMENTARY_ERROR) * scale
+}

@@ -1,0 +1,252 @@
+//! Unit tests of the curvature test and the occluders.
+
+use super::*;
+use crate::surface::Side;
+use crate::vec3::vec3;
+
+fn o() -> Vec3<f64> {
+    vec3(0.0, 0.0, 0.0)
+}
+
+#[test]
+fn curvature_test_needs_both_dot_products() {
+    let up = vec3(0.0, 0.0, 1.0);
+    let down = vec3(0.0, 0.0, -1.0);
+    let a = o();
+    let b = vec3(0.3, 0.0, 1.0);
+    assert!(mutually_facing(a, up, b, down));
+    assert!(!mutually_facing(a, up, b, up), "fig. 4b: one dot product negative");
+    assert!(!mutually_facing(a, down, b, up), "fig. 4c: both negative");
+}
+
+#[test]
+fn sphere_blocks_through_not_from_surface() {
+    let s = Sphere::outer(o(), 1.0).unwrap();
+    assert!(s.blocks(vec3(-3.0, 0.0, 0.0), vec3(3.0, 0.0, 0.0)));
+    assert!(!s.blocks(vec3(-3.0, 1.5, 0.0), vec3(3.0, 1.5, 0.0)));
+    // From a point on the sphere outward: not blocked (its own surface at τ = 0).
+    assert!(!s.blocks(vec3(1.0, 0.0, 0.0), vec3(3.0, 0.5, 0.0)));
+    // From a point on the sphere through the ball: blocked.
+    assert!(s.blocks(vec3(1.0, 0.0, 0.0), vec3(-3.0, 0.0, 0.0)));
+    // Chord between two points on the inside: visible (concave side sees itself).
+    assert!(!s.blocks(vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0)));
+    // Segment ending before the sphere.
+    assert!(!s.blocks(vec3(-3.0, 0.0, 0.0), vec3(-2.0, 0.0, 0.0)));
+}
+
+#[test]
+fn sphere_occlusion_is_scale_invariant() {
+    for k in [1e-12, 1e-6, 1.0, 1e6, 1e12] {
+        let s = Sphere::outer(o(), k).unwrap();
+        assert!(s.blocks(vec3(-3.0 * k, 0.1 * k, 0.0), vec3(3.0 * k, 0.0, 0.2 * k)));
+        assert!(!s.blocks(vec3(-3.0 * k, 1.1 * k, 0.0), vec3(3.0 * k, 1.1 * k, 0.0)));
+    }
+}
+
+#[test]
+fn parallelogram_and_disk() {
+    let sq = Parallelogram::new(vec3(-1.0, -1.0, 0.0), vec3(2.0, 0.0, 0.0), vec3(0.0, 2.0, 0.0)).unwrap();
+    assert!(sq.blocks(vec3(0.5, 0.5, -1.0), vec3(0.5, 0.5, 1.0)));
+    assert!(!sq.blocks(vec3(1.5, 0.5, -1.0), vec3(1.5, 0.5, 1.0)));
+    assert!(!sq.blocks(vec3(0.5, 0.5, 0.5), vec3(0.5, 0.5, 1.0)));
+    assert!(!sq.blocks(vec3(0.0, 0.0, 1.0), vec3(1.0, 0.0, 1.0)), "parallel");
+    let ring = Disk::annulus(o(), vec3(0.0, 0.0, 1.0), 0.5, 1.0).unwrap();
+    assert!(ring.blocks(vec3(0.75, 0.0, -1.0), vec3(0.75, 0.0, 1.0)));
+    assert!(!ring.blocks(vec3(0.2, 0.0, -1.0), vec3(0.2, 0.0, 1.0)), "through the hole");
+    assert!(!ring.blocks(vec3(1.2, 0.0, -1.0), vec3(1.2, 0.0, 1.0)));
+}
+
+#[test]
+fn cylinder_tube() {
+    let c = Cylinder::new(o(), vec3(0.0, 0.0, 1.0), 1.0, 2.0, Side::Outer).unwrap();
+    assert!(c.blocks(vec3(-3.0, 0.0, 1.0), vec3(3.0, 0.0, 1.0)));
+    assert!(!c.blocks(vec3(-3.0, 0.0, 3.0), vec3(3.0, 0.0, 3.0)), "above the tube");
+    assert!(!c.blocks(vec3(0.0, 0.0, -1.0), vec3(0.0, 0.0, 3.0)), "along the axis, open ends");
+    // Inside chord between two points on the wall: not blocked.
+    assert!(!c.blocks(vec3(1.0, 0.0, 0.5), vec3(-1.0, 0.0, 1.5)));
+    // Enters through the open top, leaves through the wall: blocked.
+    assert!(c.blocks(vec3(0.0, 0.0, 2.5), vec3(3.0, 0.0, 0.5)));
+}
+
+/// Every change of `blocks(p, origin + τ·direction)` along a line lies at a root of one of
+/// the occluder's `line_polynomials`: sampled densely on random lines, each change is
+/// bracketed by two samples 1e-4 apart and must contain a candidate.
+#[cfg(feature = "closed-form")]
+fn check_line_breaks<O: Occluder<f64>>(occluder: &O, seed: u64) -> usize {
+    let mut state = seed;
+    let mut next = || {
+        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((state >> 11) as f64) / ((1u64 << 53) as f64) * 2.0 - 1.0
+    };
+    let mut changes = 0;
+    for _ in 0..200 {
+        let p = vec3(3.0 * next(), 3.0 * next(), 3.0 + next());
+        let origin = vec3(3.0 * next(), 3.0 * next(), -3.0 + next());
+        let direction = vec3(next(), next(), 0.3 * next()).scale(4.0);
+        let mut candidates = [0.0f64; 64];
+        let mut n = 0;
+        assert!(occluder.line_polynomials(p, origin, direction, &mut |[a, b, c]| {
+            polynomial_roots(a, b, c, &mut |t| {
+                if let Some(slot) = candidates.get_mut(n) {
+                    *slot = t;
+                    n += 1;
+                }
+            });
+        }));
+        let samples = 20_000;
+        let at = |k: usize| -2.0 + 4.0 * k as f64 / samples as f64;
+        let mut prev = occluder.blocks(p, origin + direction.scale(at(0)));
+        for k in 1..=samples {
+            let now = occluder.blocks(p, origin + direction.scale(at(k)));
+            if now != prev {
+                changes += 1;
+                let (lo, hi) = (at(k - 1), at(k));
+                let found = candidates.iter().take(n).any(|&c| c >= lo - 1e-9 && c <= hi + 1e-9);
+                assert!(
+                    found,
+                    "change in [{lo}, {hi}] without a candidate (p {p:?}, line {origin:?} + t {direction:?})"
+                );
+            }
+            prev = now;
+        }
+    }
+    changes
+}
+
+#[cfg(feature = "closed-form")]
+#[test]
+fn line_polynomials_vanish_at_every_change_of_visibility() {
+    let sphere = Sphere::new(vec3(0.2, -0.1, 0.0), 1.3, Side::Outer).unwrap();
+    let quad = Parallelogram::new(vec3(-1.0, -0.5, 0.3), vec3(2.0, 0.4, 0.1), vec3(-0.3, 1.5, 0.2)).unwrap();
+    let disk = Disk::annulus(vec3(0.1, 0.2, -0.2), vec3(0.2, 0.1, 1.0), 0.4, 1.6).unwrap();
+    // Each occluder must actually cast shadows on the sampled lines.
+    assert!(check_line_breaks(&sphere, 1) > 100);
+    assert!(check_line_breaks(&quad, 2) > 100);
+    assert!(check_line_breaks(&disk, 3) > 100);
+    let mixed = [AnyOccluder::Sphere(sphere), AnyOccluder::Parallelogram(quad), AnyOccluder::Disk(disk)];
+    assert!(check_line_breaks(&mixed, 4) > 100);
+    let tube = Cylinder::new(vec3(0.0, 0.0, -1.0), vec3(0.0, 0.0, 1.0), 1.0, 2.0, Side::Outer).unwrap();
+    assert!(!tube.line_polynomials(vec3(0.0, 0.0, 3.0), vec3(0.0, 0.0, -3.0), vec3(1.0, 0.0, 0.0), &mut |_| {}));
+}
+
+#[test]
+fn polynomial_roots_are_accurate_and_complete() {
+    let roots = |a: f64, b: f64, c: f64| {
+        let mut r = [f64::NAN; 2];
+        let mut n = 0;
+        polynomial_roots(a, b, c, &mut |x| {
+            if let Some(slot) = r.get_mut(n) {
+                *slot = x;
+            }
+            n += 1;
+        });
+        (n, r)
+    };
+    // (τ − 1e8)(τ − 1e-8): the small root without cancellation.
+    let (n, r) = roots(1.0, -(1e8 + 1e-8), 1.0);
+    assert_eq!(n, 2);
+    assert!(r.iter().any(|&x| ((x - 1e-8) / 1e-8).abs() < 1e-15));
+    assert_eq!(roots(0.0, 2.0, -1.0).0, 1);
+    assert_eq!(roots(0.0, 2.0, -1.0).1[0], 0.5);
+    assert_eq!(roots(0.0, 0.0, 1.0).0, 0);
+    assert_eq!(roots(1.0, 0.0, 1.0).0, 0);
+    assert_eq!(roots(1.0, -2.0, 1.0).0, 1);
+}
+
+#[test]
+fn combinations() {
+    let s = Sphere::outer(vec3(0.0, 0.0, 0.0), 1.0).unwrap();
+    let far = Sphere::outer(vec3(0.0, 10.0, 0.0), 1.0).unwrap();
+    let (p, q) = (vec3(-3.0, 0.0, 0.0), vec3(3.0, 0.0, 0.0));
+    assert!([far, s].blocks(p, q));
+    assert!(![far].blocks(p, q));
+    assert!((far, AnyOccluder::Sphere(s)).blocks(p, q));
+    let mut v: heapless::Vec<AnyOccluder<f64>, 4> = heapless::Vec::new();
+    assert!(!v.blocks(p, q));
+    v.push(AnyOccluder::Sphere(s)).unwrap();
+    assert!(v.blocks(p, q));
+    assert!(!<() as Occluder<f64>>::blocks(&(), p, q));
+    assert!(Some(s).blocks(p, q));
+    let a = Ball { center: vec3(0.0, 5.0, -3.0), radius: 0.5 };
+    let b = Ball { center: vec3(0.0, 5.0, 3.0), radius: 0.5 };
+    assert!(!s.may_block_between(&a, &b));
+    assert!(
+        far.may_block_between(&Ball { center: p, radius: 0.5 }, &Ball { center: vec3(0.0, 13.0, 0.0), radius: 0.1 })
+    );
+}
+
+/// A small deterministic generator for the geometric tests (xorshift64*), values in [-1, 1).
+struct Lcg(u64);
+impl Lcg {
+    fn next(&mut self) -> f64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        let x = self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11;
+        2.0 * (x as f64 / (1u64 << 53) as f64) - 1.0
+    }
+    fn vec(&mut self, scale: f64) -> Vec3<f64> {
+        vec3(self.next() * scale, self.next() * scale, self.next() * scale)
+    }
+}
+
+/// The hull of two balls is the union of the balls centred on the segment between their
+/// centres with linearly interpolated radii: an independent way to get the distance.
+#[test]
+fn hull_distance_matches_union_of_interpolated_balls() {
+    let mut rng = Lcg(0x9e37_79b9_7f4a_7c15);
+    let mut inside = 0;
+    for case in 0..2000 {
+        let a = Ball { center: rng.vec(3.0), radius: if case % 5 == 0 { 0.0 } else { 1.0 + rng.next() } };
+        let b = Ball { center: rng.vec(3.0), radius: 1.0 + rng.next() };
+        let x = rng.vec(3.0);
+        let mut brute = f64::INFINITY;
+        for k in 0..=20_000 {
+            let l = f64::from(k) / 20_000.0;
+            let c = a.center.scale(1.0 - l) + b.center.scale(l);
+            let r = a.radius * (1.0 - l) + b.radius * l;
+            brute = brute.min(((x - c).norm() - r).max(0.0));
+        }
+        let d = distance_to_hull_of_balls(x, &a, &b);
+        // The λ grid overestimates the minimum by at most (step · slope)² scale.
+        assert!(d <= brute + 1e-12, "case {case}: {d} > {brute}");
+        assert!(brute - d <= 1e-6, "case {case}: {d} vs {brute}");
+        inside += usize::from(d == 0.0);
+    }
+    assert!(inside > 50 && inside < 1900, "cases inside the hull: {inside}");
+}
+
+/// Whenever the sphere claims to hide a ball from p, every probed segment from p into the
+/// ball (surface and interior points) is blocked; and it does claim so in many cases.
+#[test]
+#[cfg(feature = "closed-form")]
+fn sphere_hides_ball_only_when_every_segment_is_blocked() {
+    let mut rng = Lcg(0x1234_5678_9abc_def1);
+    let sphere = Sphere::outer(o(), 1.0).unwrap();
+    let mut hidden = 0;
+    for case in 0..4000 {
+        // p outside, b roughly behind the sphere as seen from p.
+        let p = rng.vec(1.0) + vec3(0.0, 0.0, 2.0 + 2.0 * rng.next().abs());
+        let behind = (o() - p).scale(1.0 + 2.0 * rng.next().abs());
+        let b = Ball { center: o() + behind + rng.vec(0.7), radius: 0.6 * rng.next().abs() };
+        if !sphere.hides_ball_from(p, &b) {
+            continue;
+        }
+        hidden += 1;
+        for _ in 0..200 {
+            let u = rng.vec(1.0);
+            let dir = if u.norm() > 1e-9 { u.scale(1.0 / u.norm()) } else { vec3(1.0, 0.0, 0.0) };
+            for f in [1.0, rng.next().abs()] {
+                let q = b.center + dir.scale(b.radius * f);
+                assert!(sphere.blocks(p, q), "case {case}: {p:?} -> {q:?} not blocked");
+            }
+        }
+    }
+    assert!(hidden > 200, "hidden in only {hidden} cases");
+    // Not hidden: p inside, a ball overlapping the tangent cone's edge, a ball in front.
+    let b = Ball { center: vec3(0.0, 0.0, -3.0), radius: 0.1 };
+    assert!(sphere.hides_ball_from(vec3(0.0, 0.0, 3.0), &b));
+    assert!(!sphere.hides_ball_from(vec3(0.0, 0.0, 0.5), &b));
+    assert!(!sphere.hides_ball_from(vec3(0.0, 0.0, 3.0), &Ball { center: vec3(1.9, 0.0, -3.0), radius: 0.5 }));
+    assert!(!sphere.hides_ball_from(vec3(0.0, 0.0, 3.0), &Ball { center: vec3(0.0, 0.0, 1.5), radius: 0.1 }));
+}
