@@ -1,0 +1,507 @@
+//! The inner integral J(p) over patch b from one outer point p: the visible part of b found
+//! line by line (closed form on a parallelogram, bracketing elsewhere), the refinement towards
+//! a close p, and Lambert's point-to-polygon form where it applies.
+
+use super::*;
+
+/// The inner patch b with everything needed to integrate over its visible part from one point.
+pub(super) struct Inner<'x, T: Real, SB: Surface<T> + ?Sized, O: ?Sized> {
+    pub(super) surface: &'x SB,
+    pub(super) r: ParamRect<T>,
+    pub(super) rule: GaussRule<T>,
+    pub(super) probes: usize,
+    /// b's affine map when visibility is handled in closed form.
+    pub(super) affine: Option<(Vec3<T>, Vec3<T>, Vec3<T>)>,
+    /// b's outline when b is flat but not a parallelogram (a disk or annulus sector, a planar
+    /// Bézier patch): the point-to-region form along it.
+    #[cfg(feature = "closed-form")]
+    pub(super) outline: Option<crate::contour::Outline<'x, T, SB>>,
+    /// The rule along the outline's edges: at least order 16, whose few hundred evaluations per
+    /// outer point make J(p) exact to rounding at any outer order.
+    #[cfg(feature = "closed-form")]
+    pub(super) line_rule: GaussRule<T>,
+    pub(super) use_occluders: bool,
+    pub(super) occluders: &'x O,
+    pub(super) count: &'x core::cell::Cell<u64>,
+    /// Buffers of [`Inner::line`] in closed form.
+    pub(super) scratch: core::cell::RefCell<LineScratch<T>>,
+    /// The line [`Inner::line_signature`] computes into.
+    pub(super) signature_line: core::cell::RefCell<Line<T>>,
+}
+
+impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB, O> {
+    pub(super) fn tick(&self) {
+        self.count.set(self.count.get().saturating_add(1));
+    }
+
+    /// On a flat b (closed-form mode), the facing tests from p over all of b, decided at b's
+    /// corners (both are affine on b): `Some(true)` if every q of b and p face each other,
+    /// `Some(false)` if none do, `None` if b straddles a facing boundary or is not flat.
+    pub(super) fn facing_from(&self, p: Vec3<T>, np: Vec3<T>) -> Option<bool> {
+        let (o, et, es) = self.affine?;
+        let r = self.r;
+        let nq = self.surface.normal(r.t0, r.s0);
+        let corners = [(r.t0, r.s0), (r.t1, r.s0), (r.t0, r.s1), (r.t1, r.s1)];
+        let (mut sees, mut ahead_of_p, mut ahead_of_q) = (0usize, 0usize, 0usize);
+        for (t, s) in corners {
+            let (ca, cb, _) = integrand::cosines(p, np, o + et.scale(t) + es.scale(s), nq);
+            let (towards_q, towards_p) = (ca > T::ZERO, cb > T::ZERO);
+            sees += usize::from(towards_q && towards_p);
+            ahead_of_p += usize::from(towards_q);
+            ahead_of_q += usize::from(towards_p);
+        }
+        if sees == corners.len() {
+            Some(true)
+        } else if ahead_of_p == 0 || ahead_of_q == 0 {
+            Some(false)
+        } else {
+            None
+        }
+    }
+
+    /// Both facing tests and the occluders for the segment p → q.
+    pub(super) fn visible(&self, p: Vec3<T>, np: Vec3<T>, q: Vec3<T>, nq: Vec3<T>) -> bool {
+        self.tick();
+        mutually_facing(p, np, q, nq) && !(self.use_occluders && self.occluders.blocks(p, q))
+    }
+
+    /// The polynomials in t whose roots contain every visibility change on the t-line at s
+    /// (closed-form mode): the two facing tests (linear) and the occluders'. `false` if the
+    /// capacity is exceeded or an occluder declines.
+    pub(super) fn line_polys(&self, p: Vec3<T>, np: Vec3<T>, s: T, polys: &mut Polys<T>) -> bool {
+        let Some((o, et, es)) = self.affine else { return false };
+        let origin = o + es.scale(s);
+        let w0 = origin - p;
+        let nq = self.surface.normal(self.r.t0, s);
+        polys.n = 0;
+        polys.push([T::ZERO, np.dot(et), np.dot(w0)]);
+        polys.push([T::ZERO, nq.dot(et), nq.dot(w0)]);
+        if self.use_occluders && !occluder_polynomials(self.occluders, p, origin, et, &mut |c| polys.push(c)) {
+            return false;
+        }
+        !polys.overflow
+    }
+
+    /// The visible pieces of the t-line of b at s over r's t-range, seen from p.
+    pub(super) fn line(
+        &self,
+        p: Vec3<T>,
+        np: Vec3<T>,
+        r: ParamRect<T>,
+        s: T,
+        line: &mut Line<T>,
+    ) -> Result<(), PdmError> {
+        let vis_at = |t: T| {
+            let (q, nq) = self.surface.point_and_normal(t, s);
+            self.visible(p, np, q, nq)
+        };
+        if self.affine.is_some() {
+            // Reused buffers (zeroing them on every line cost ≈ 6 % of the run time); a fresh
+            // set if they are in use (never: lines are not computed re-entrantly).
+            let mut fresh = None;
+            let mut borrowed = self.scratch.try_borrow_mut();
+            let scratch: &mut LineScratch<T> = match borrowed.as_deref_mut() {
+                Ok(scratch) => scratch,
+                Err(_) => fresh.insert(LineScratch::new()),
+            };
+            let LineScratch { polys, candidates } = scratch;
+            if self.line_polys(p, np, s, polys) && closed_form_line(polys.used(), r.t0, r.t1, &vis_at, candidates, line)
+            {
+                return Ok(());
+            }
+        }
+        // Bracket visibility changes along the line, refine each by bisection.
+        line.n = 0;
+        line.ids = 0;
+        push(&mut line.breaks, &mut line.n, r.t0)?;
+        locate_changes(&vis_at, r.t0, r.t1, self.probes, &mut line.breaks, &mut line.n)?;
+        push(&mut line.breaks, &mut line.n, r.t1)?;
+        let first_hi = line.breaks.get(1).copied().unwrap_or(r.t1);
+        line.first_visible = vis_at((r.t0 + first_hi) * T::HALF);
+        Ok(())
+    }
+
+    /// The structure of a line: (number of breakpoints, visibility of the first piece, which
+    /// polynomials make the breaks); an error counts as its own structure (it is reported
+    /// again when the line is integrated).
+    pub(super) fn line_signature(&self, p: Vec3<T>, np: Vec3<T>, r: ParamRect<T>, s: T) -> (usize, bool, u64) {
+        let mut fresh = None;
+        let mut borrowed = self.signature_line.try_borrow_mut();
+        let line: &mut Line<T> = match borrowed.as_deref_mut() {
+            Ok(line) => line,
+            Err(_) => fresh.insert(Line::new()),
+        };
+        match self.line(p, np, r, s, line) {
+            Ok(()) => (line.n, line.first_visible, line.ids),
+            Err(_) => (usize::MAX, false, 0),
+        }
+    }
+
+    /// The singular points in s of the inner integral (closed-form mode): the lines' structure
+    /// changes where a root of a polynomial crosses a t-edge (a quadratic in s) or two roots of
+    /// one polynomial meet (its discriminant, a quartic in s); these candidates are found
+    /// exactly and kept where the structure differs on the two sides. Other changes (two
+    /// polynomials' roots crossing: a polygonal shadow's corner, two shadows meeting) are
+    /// bracketed and bisected between them. Returns the nearest singular points just outside
+    /// [s0, s1] (within a quarter of its width), towards which the end pieces are graded;
+    /// `None` (with nothing pushed) if the lines' polynomials are not available from p.
+    pub(super) fn closed_form_events(
+        &self,
+        p: Vec3<T>,
+        np: Vec3<T>,
+        r: ParamRect<T>,
+        out: &mut [T; MAX_BREAKS + 2],
+        n: &mut usize,
+    ) -> Result<Option<Outside<T>>, PdmError> {
+        let h = r.s1 - r.s0;
+        // The coefficients as quadratics in x ∈ [0, 1] (s = s0 + x·h), from three lines.
+        let (mut p0, mut ph, mut p1) = (Polys::new(), Polys::new(), Polys::new());
+        let ok = self.line_polys(p, np, r.s0, &mut p0)
+            && self.line_polys(p, np, r.s0 + h * T::HALF, &mut ph)
+            && self.line_polys(p, np, r.s1, &mut p1)
+            && p0.n == ph.n
+            && ph.n == p1.n;
+        if !ok {
+            return Ok(None);
+        }
+        // Candidates with the polynomial they come from; an overflow makes every sub-interval
+        // count as possibly crossed (see below).
+        let mut candidates = [(T::ZERO, 0usize); 4 * MAX_BREAKS];
+        let mut nc = 0usize;
+        let mut overflow = false;
+        // Candidates just outside b count too: a singular point close beyond an edge slows the
+        // rule on the piece at that edge (it is graded towards it).
+        let reach = T::HALF * T::HALF;
+        let fit = |v0: T, vh: T, v1: T| -> [T; 3] {
+            let four = T::TWO * T::TWO;
+            [v0, four * vh - T::from_f64(3.0) * v0 - v1, T::TWO * (v1 + v0) - four * vh]
+        };
+        // Each polynomial's coefficients (a, b, c) as quadratics in x.
+        let mut fits = [[[T::ZERO; 3]; 3]; MAX_POLYS];
+        let polys = p0.used().iter().zip(ph.used()).zip(p1.used());
+        for (id, (((&[a0, b0, k0], &[ah, bh, kh]), &[a1, b1, k1]), slot)) in polys.zip(fits.iter_mut()).enumerate() {
+            let (qa, qb, qc) = (fit(a0, ah, a1), fit(b0, bh, b1), fit(k0, kh, k1));
+            *slot = [qa, qb, qc];
+            let mut add = |x: T| {
+                if x > -reach && x < T::ONE + reach {
+                    match candidates.get_mut(nc) {
+                        Some(c) => {
+                            *c = (r.s0 + h * x, id);
+                            nc += 1;
+                        }
+                        None => overflow = true,
+                    }
+                }
+            };
+            // A root crossing the t-edges: P(t_edge; x) = a(x) t² + b(x) t + c(x), coefficient by
+            // coefficient in x.
+            for t in [r.t0, r.t1] {
+                let e = |k: usize| {
+                    let g = |q: &[T; 3]| q.get(k).copied().unwrap_or(T::ZERO);
+                    g(&qa) * t * t + g(&qb) * t + g(&qc)
+                };
+                crate::visibility::polynomial_roots(e(2), e(1), e(0), &mut add);
+            }
+            // Two roots meeting: D(x) = b(x)² − 4 a(x) c(x), a quartic (roots in (−¼, 1¼)).
+            if qa.iter().any(|&c| c != T::ZERO) {
+                let bb = square(&qb);
+                let ac = product(&qa, &qc);
+                let four = T::TWO * T::TWO;
+                let d = [
+                    bb[0] - four * ac[0],
+                    bb[1] - four * ac[1],
+                    bb[2] - four * ac[2],
+                    bb[3] - four * ac[3],
+                    bb[4] - four * ac[4],
+                ];
+                roots_in_interval(&d, -reach, T::ONE + reach, &mut add);
+            }
+        }
+        let fits = fits.get(..p0.n).unwrap_or_default();
+        let candidates = candidates.get_mut(..nc).unwrap_or_default();
+        sort_by_position(candidates);
+        let candidates = &*candidates;
+        // How many polynomials have a root inside (t0, t1) somewhere in [from, hi]: those with
+        // one at `from`, and those with a candidate inside (a root enters the line's range only
+        // across a t-edge or as a double root, both candidates).
+        let with_roots_inside = |from: T, hi: T| -> usize {
+            let x = (from - r.s0) / h;
+            let mut count = 0;
+            for (id, [qa, qb, qc]) in fits.iter().enumerate() {
+                let mut inside = candidates.iter().any(|&(c, i)| i == id && c > from && c < hi);
+                if !inside {
+                    let at = |q: &[T; 3]| horner(q, x);
+                    crate::visibility::polynomial_roots(at(qa), at(qb), at(qc), &mut |t| {
+                        inside |= t > r.t0 && t < r.t1;
+                    });
+                }
+                count += usize::from(inside);
+            }
+            count
+        };
+        // Keep the candidates where the line structure actually changes.
+        let delta = h * T::EPSILON.sqrt();
+        let mut kept_at = [T::ZERO; MAX_BREAKS + 2];
+        let mut kept = 0usize;
+        let mut last = r.s0 - h;
+        let mut outside: Outside<T> = (None, None);
+        for &(c, _) in candidates {
+            if c - last <= delta {
+                continue;
+            }
+            if self.line_signature(p, np, r, c - delta) != self.line_signature(p, np, r, c + delta) {
+                last = c;
+                if c <= r.s0 + delta {
+                    outside.0 = Some(c.min(r.s0 - delta));
+                } else if c >= r.s1 - delta {
+                    if outside.1.is_none() {
+                        outside.1 = Some(c.max(r.s1 + delta));
+                    }
+                } else {
+                    push(out, n, c)?;
+                    push(&mut kept_at, &mut kept, c)?;
+                }
+            }
+        }
+        // Anything else between them (two polynomials' roots crossing): bracket and bisect,
+        // where at least two polynomials have roots on the lines.
+        let mut lo = r.s0;
+        for k in 0..=kept {
+            let next = if k < kept { kept_at.get(k).copied() } else { None };
+            let hi = next.map_or(r.s1, |c| c - delta);
+            let from = if k == 0 { lo } else { lo + delta };
+            if hi > from && (overflow || with_roots_inside(from, hi) >= 2) {
+                let span = (hi - from) / h;
+                // Probes in proportion to the sub-interval's share of [s0, s1] (at least 3).
+                let mut probes = 3;
+                while probes < self.probes && T::from_usize(probes) < T::from_usize(self.probes) * span {
+                    probes += 1;
+                }
+                locate_changes(&|s: T| self.line_signature(p, np, r, s), from, hi, probes, out, n)?;
+            }
+            lo = next.unwrap_or(r.s1);
+        }
+        Ok(Some(outside))
+    }
+
+    /// J(p) over the whole of a flat b (closed-form mode) with nothing between p and b, by the
+    /// point-to-polygon (Lambert) form: the visible part of b is the polygon P = b ∩ {q : n̂_p·(q − p) > 0}
+    /// (the other facing test is constant on a flat b), and with its vertices v_k seen from p,
+    /// R_k = v_k − p,
+    ///
+    /// J(p) = ∫_P cos θ_p cos θ_q / L² dA = ½ |Σ_k γ_k n̂_p·(R_k × R_{k+1})/|R_k × R_{k+1}||,
+    ///
+    /// γ_k the angle between R_k and R_{k+1} (Hottel & Sarofim 1967; `../shared/REFERENCES.md`).
+    /// Exact however close p comes to b, where a product rule over b needs refining towards p.
+    /// The terms are O(γ) while J can be O(γ²) (a small polygon far from p): `None` where they
+    /// cancel by more than [`POLYGON_CANCELLATION`], and the caller integrates by the rule.
+    pub(super) fn point_to_polygon(&self, p: Vec3<T>, np: Vec3<T>) -> Option<T> {
+        let Some((o, et, es)) = self.affine else {
+            return self.point_to_outline(p, np);
+        };
+        let r = self.r;
+        let nq = self.surface.normal(r.t0, r.s0);
+        let at = |t: T, s: T| o + et.scale(t) + es.scale(s);
+        let quad = [at(r.t0, r.s0), at(r.t1, r.s0), at(r.t1, r.s1), at(r.t0, r.s1)];
+        if !(nq.dot(p - quad[0]) > T::ZERO) {
+            return Some(T::ZERO);
+        }
+        // Clip by p's tangent plane (Sutherland–Hodgman against one plane): at most 5 vertices.
+        let mut poly = [Vec3::ZERO; 5];
+        let mut n = 0usize;
+        let mut keep = |v: Vec3<T>| {
+            if let Some(slot) = poly.get_mut(n) {
+                *slot = v;
+                n += 1;
+            }
+        };
+        for k in 0..4 {
+            let (Some(&a), Some(&b)) = (quad.get(k), quad.get((k + 1) % 4)) else { continue };
+            let (da, db) = (np.dot(a - p), np.dot(b - p));
+            if da > T::ZERO {
+                keep(a);
+            }
+            if (da > T::ZERO) != (db > T::ZERO) {
+                keep(a + (b - a).scale(da / (da - db)));
+            }
+        }
+        self.tick();
+        if n < 3 {
+            return Some(T::ZERO);
+        }
+        let (mut sum, mut magnitude) = (T::ZERO, T::ZERO);
+        let used = poly.get(..n).unwrap_or_default();
+        for (k, &v) in used.iter().enumerate() {
+            let Some(&w) = used.get((k + 1) % n) else { continue };
+            let (a, b) = (v - p, w - p);
+            let c = a.cross(b);
+            let sine = c.norm();
+            if !(sine > T::ZERO) {
+                continue;
+            }
+            let term = sine.atan2(a.dot(b)) * np.dot(c) / sine;
+            sum += term;
+            magnitude += term.abs();
+        }
+        let j = sum.abs() * T::HALF;
+        (j.is_finite() && magnitude <= T::from_f64(POLYGON_CANCELLATION) * sum.abs()).then_some(j)
+    }
+
+    /// [`Self::point_to_polygon`] on a flat b with curved edges, along its outline
+    /// (`contour::Outline::point_form`); `None` where b has no outline.
+    #[cfg(feature = "closed-form")]
+    pub(super) fn point_to_outline(&self, p: Vec3<T>, np: Vec3<T>) -> Option<T> {
+        let (j, magnitude, n) = self.outline.as_ref()?.point_form(&self.line_rule, p, np)?;
+        self.count.set(self.count.get().saturating_add(n));
+        (magnitude <= T::from_f64(POLYGON_CANCELLATION) * j).then_some(j)
+    }
+
+    /// Without closed forms there is no outline form.
+    #[cfg(not(feature = "closed-form"))]
+    pub(super) fn point_to_outline(&self, _p: Vec3<T>, _np: Vec3<T>) -> Option<T> {
+        None
+    }
+
+    /// `true` if p lies closer to the ball than its radius: a rule over the ball's patch then
+    /// converges slowly (the kernel's nearest singularity, at p, is within the patch's size).
+    pub(super) fn near(&self, p: Vec3<T>, ball: &Ball<T>) -> bool {
+        (ball.center - p).norm() - ball.radius < ball.radius
+    }
+
+    /// The distance from `ball` to the part r of b ([`distance_to_part`]).
+    pub(super) fn distance_from(&self, ball: &Ball<T>, r: ParamRect<T>) -> Result<T, PdmError> {
+        distance_to_part(self.surface, self.affine, ball, r, T::MAX, 0)
+    }
+
+    /// The smallest ball known to contain the part r of b (exact corners when flat).
+    pub(super) fn ball_of(&self, r: ParamRect<T>) -> Result<Ball<T>, PdmError> {
+        part_ball(self.surface, self.affine, r)
+    }
+
+    /// J(p) = ∫_b visible (n̂_p·e)(−n_q·e)/L⁴ dq (without the 1/π) over the part r of b,
+    /// refined towards p: a part that p is [`near`](Self::near) is split 2 × 2 (up to
+    /// [`MAX_NEAR_DEPTH`] times), so that every part is integrated from at least its own radius
+    /// away and the rule's error falls like 2^(−2·order) or faster whatever the gap.
+    pub(super) fn refined(&self, p: Vec3<T>, np: Vec3<T>, r: ParamRect<T>, depth: u32) -> Result<T, PdmError> {
+        if depth < MAX_NEAR_DEPTH && self.near(p, &self.ball_of(r)?) {
+            let mut sum = T::ZERO;
+            for k in 0..4 {
+                sum += self.refined(p, np, r.cell(k / 2, k % 2, 2, 2), depth + 1)?;
+            }
+            return Ok(sum);
+        }
+        self.integral_split(p, np, r, 0)
+    }
+
+    /// J(p) over the part r of b; where one part holds more visibility changes than the
+    /// fixed buffers ([`MAX_BREAKS`] per line or in s), it is halved (alternately in s and t,
+    /// at most [`MAX_SPLITS`] times) and the halves are integrated separately.
+    pub(super) fn integral_split(&self, p: Vec3<T>, np: Vec3<T>, r: ParamRect<T>, depth: u32) -> Result<T, PdmError> {
+        match self.integral_over(p, np, r) {
+            Err(PdmError::CapacityExceeded { .. }) if depth < MAX_SPLITS => {
+                let (lo, hi) = if depth.is_multiple_of(2) {
+                    let m = (r.s0 + r.s1) * T::HALF;
+                    (ParamRect { s1: m, ..r }, ParamRect { s0: m, ..r })
+                } else {
+                    let m = (r.t0 + r.t1) * T::HALF;
+                    (ParamRect { t1: m, ..r }, ParamRect { t0: m, ..r })
+                };
+                Ok(self.integral_split(p, np, lo, depth + 1)? + self.integral_split(p, np, hi, depth + 1)?)
+            }
+            Err(PdmError::CapacityExceeded { .. }) => Ok(self.integral_sampled(p, np, r)),
+            other => other,
+        }
+    }
+
+    /// J(p) over a part r of b that still holds more visibility changes than the buffers after
+    /// [`MAX_SPLITS`] halvings (at most a ⅛ × ⅛ part of b: changes that halving does not
+    /// separate, such as rounding noise where a boundary grazes b along a line): the tensor
+    /// Gauss rule with the visibility tested at each node, as the plain sum does. Its error
+    /// stays within that part.
+    pub(super) fn integral_sampled(&self, p: Vec3<T>, np: Vec3<T>, r: ParamRect<T>) -> T {
+        let (ht, hs) = ((r.t1 - r.t0) * T::HALF, (r.s1 - r.s0) * T::HALF);
+        let mut sum = T::ZERO;
+        for (xs, ws) in self.rule.points() {
+            let s = r.s0 + hs * (xs + T::ONE);
+            for (xt, wt) in self.rule.points() {
+                let (q, nq) = self.surface.point_and_normal(r.t0 + ht * (xt + T::ONE), s);
+                if self.visible(p, np, q, nq) {
+                    sum += ws * wt * kernel(p, np, q, nq);
+                }
+            }
+        }
+        sum * ht * hs
+    }
+
+    /// J(p) over the part r of b (r's t- and s-ranges inside b's).
+    pub(super) fn integral_over(&self, p: Vec3<T>, np: Vec3<T>, r: ParamRect<T>) -> Result<T, PdmError> {
+        // J is smooth in s except where the visible set of the t-line changes its structure:
+        // a boundary crossing a t-edge, or a boundary tangent to the t-lines (two breakpoints
+        // meeting). Split the s-range there.
+        let mut s_breaks = [T::ZERO; MAX_BREAKS + 2];
+        let mut ns = 0usize;
+        push(&mut s_breaks, &mut ns, r.s0)?;
+        let mut outside = (None, None);
+        let in_closed_form = match self.affine {
+            Some(_) => self.closed_form_events(p, np, r, &mut s_breaks, &mut ns)?,
+            None => None,
+        };
+        if let Some(o) = in_closed_form {
+            outside = o;
+        } else {
+            // The edges are probed just inside b: an edge may be a pole or a disk's centre,
+            // where the normal vanishes and no facing test is defined.
+            let inset = (r.t1 - r.t0) * end_inset::<T>();
+            for t_edge in [r.t0 + inset, r.t1 - inset] {
+                let vis_edge = |s: T| {
+                    let (q, nq) = self.surface.point_and_normal(t_edge, s);
+                    self.visible(p, np, q, nq)
+                };
+                locate_changes(&vis_edge, r.s0, r.s1, self.probes, &mut s_breaks, &mut ns)?;
+            }
+        }
+        push(&mut s_breaks, &mut ns, r.s1)?;
+        let s_used = s_breaks.get_mut(..ns).unwrap_or_default();
+        sort(s_used);
+        let mut inner = T::ZERO;
+        let mut line = Line::new();
+        // Where two breakpoints of the t-lines meet (a boundary tangent to the lines) the
+        // visible length grows like √(s − s*): J(s) has a square-root end point, which a
+        // Gauss rule integrates only algebraically. s = s* + H·x² (or the smoothstep
+        // 3x² − 2x³ with both ends graded) makes it smooth in x; at the other interior
+        // breaks (a boundary crossing a t-edge) the map is harmless.
+        for_each_piece(s_used, r.s0, r.s1, outside, |s_lo, s_hi, grade_lo, grade_hi| {
+            let width = s_hi - s_lo;
+            for (xs, ws) in self.rule.points() {
+                let (u, du) = graded((xs + T::ONE) * T::HALF, grade_lo, grade_hi);
+                let s = s_lo + width * u;
+                self.line(p, np, r, s, &mut line)?;
+                // Integrate the visible pieces (visibility alternates from the first piece).
+                let mut sum = T::ZERO;
+                let mut visible_piece = line.first_visible;
+                for w in line.breaks.get(..line.n).unwrap_or_default().windows(2) {
+                    let (lo, hi) = match w {
+                        [lo, hi] => (*lo, *hi),
+                        _ => continue,
+                    };
+                    let this_visible = visible_piece;
+                    visible_piece = !visible_piece;
+                    if !this_visible || !(hi > lo) {
+                        continue;
+                    }
+                    let half = (hi - lo) * T::HALF;
+                    let mut piece = T::ZERO;
+                    for (xt, wt) in self.rule.points() {
+                        let (q, nq) = self.surface.point_and_normal(lo + half * (xt + T::ONE), s);
+                        self.tick();
+                        piece += wt * kernel(p, np, q, nq);
+                    }
+                    sum += piece * half;
+                }
+                inner += ws * T::HALF * du * width * sum;
+            }
+            Ok(())
+        })?;
+        Ok(inner)
+    }
+}

@@ -1,0 +1,324 @@
+//! One inner line in closed form: the polynomials of the facing tests and the occluders along
+//! the line, their roots in s (the visibility changes), and the graded pieces between them.
+
+use super::*;
+
+/// Most polynomials describing visibility along one line (two facing tests + the occluders').
+pub(super) const MAX_POLYS: usize = 40;
+
+/// The polynomials a τ² + b τ + c of one line.
+pub(super) struct Polys<T> {
+    pub(super) list: [[T; 3]; MAX_POLYS],
+    pub(super) n: usize,
+    pub(super) overflow: bool,
+}
+
+impl<T: Real> Polys<T> {
+    pub(super) fn new() -> Self {
+        Self { list: [[T::ZERO; 3]; MAX_POLYS], n: 0, overflow: false }
+    }
+    pub(super) fn push(&mut self, c: [T; 3]) {
+        match self.list.get_mut(self.n) {
+            Some(slot) => {
+                *slot = c;
+                self.n += 1;
+            }
+            None => self.overflow = true,
+        }
+    }
+    pub(super) fn used(&self) -> &[[T; 3]] {
+        self.list.get(..self.n).unwrap_or_default()
+    }
+}
+
+/// Calls `f(lo, hi, graded_lo, graded_hi)` for the pieces of [start, end] between the sorted
+/// singular points `breaks` (which include start and end). A piece next to a much narrower
+/// neighbour has another singular point just beyond its end, where a Gauss rule converges
+/// slowly; it is cut geometrically towards that end (widths w, 3w, 12w, … from the end, w the
+/// neighbour's width), so every sub-piece sees that point at least its own length away. Only
+/// ends at singular points are graded.
+pub(super) fn for_each_piece<T: Real>(
+    breaks: &[T],
+    start: T,
+    end: T,
+    outside: Outside<T>,
+    mut f: impl FnMut(T, T, bool, bool) -> Result<(), PdmError>,
+) -> Result<(), PdmError> {
+    const MAX_LEVELS: usize = 24;
+    let n = breaks.len();
+    for k in 0..n.saturating_sub(1) {
+        let (Some(&lo), Some(&hi)) = (breaks.get(k), breaks.get(k + 1)) else { continue };
+        if !(hi > lo) {
+            continue;
+        }
+        let width = hi - lo;
+        let quarter = width * T::HALF * T::HALF;
+        let (grade_lo, grade_hi) = (lo > start, hi < end);
+        // Neighbour widths (a singular point that close beyond the end).
+        let before = if k == 0 { outside.0 } else { breaks.get(k - 1).copied() };
+        let after = if k + 2 == n { outside.1 } else { breaks.get(k + 1 + 1).copied() };
+        let left = match before {
+            Some(l) if lo - l < quarter && lo - l > T::ZERO => Some(lo - l),
+            _ => None,
+        };
+        let right = match after {
+            Some(r) if r - hi < quarter && r - hi > T::ZERO => Some(r - hi),
+            _ => None,
+        };
+        let mid = lo + width * T::HALF;
+        // From the left: [lo, lo + w], [lo + w, lo + 4w], … up to the middle.
+        let mut a = lo;
+        if let Some(w) = left {
+            let mut step = w;
+            let mut first = true;
+            for _ in 0..MAX_LEVELS {
+                let b = lo + step;
+                if !(b < mid) {
+                    break;
+                }
+                f(a, b, first && grade_lo, false)?;
+                first = false;
+                a = b;
+                step *= T::from_f64(4.0);
+            }
+        }
+        // From the right, mirrored, collected as the cut points below `hi`.
+        let mut b_end = hi;
+        let mut cuts = [T::ZERO; MAX_LEVELS];
+        let mut nc = 0usize;
+        if let Some(w) = right {
+            let mut step = w;
+            for _ in 0..MAX_LEVELS {
+                let c = hi - step;
+                if !(c > mid) || !(c > a) {
+                    break;
+                }
+                if let Some(slot) = cuts.get_mut(nc) {
+                    *slot = c;
+                    nc += 1;
+                }
+                step *= T::from_f64(4.0);
+            }
+            if let Some(&c) = nc.checked_sub(1).and_then(|j| cuts.get(j)) {
+                b_end = c;
+            }
+        }
+        f(a, b_end, grade_lo && left.is_none(), grade_hi && right.is_none())?;
+        // The right cuts, innermost first: [c_{j}, c_{j-1}], …, [c_0, hi].
+        for j in (0..nc).rev() {
+            let (Some(&c), next) = (cuts.get(j), if j == 0 { Some(&hi) } else { cuts.get(j - 1) }) else { continue };
+            let Some(&d) = next else { continue };
+            f(c, d, false, j == 0 && grade_hi)?;
+        }
+    }
+    Ok(())
+}
+
+/// The map x ↦ (u, du/dx) of [0, 1] onto itself with du/dx = 0 at the graded ends.
+#[inline]
+pub(super) fn graded<T: Real>(x: T, lo: bool, hi: bool) -> (T, T) {
+    let three = T::from_f64(3.0);
+    match (lo, hi) {
+        (true, true) => (x * x * (three - T::TWO * x), T::from_f64(6.0) * x * (T::ONE - x)),
+        (true, false) => (x * x, T::TWO * x),
+        (false, true) => {
+            let y = T::ONE - x;
+            (T::ONE - y * y, T::TWO * y)
+        }
+        (false, false) => (x, T::ONE),
+    }
+}
+
+/// The visibility structure of one inner line: `breaks[..n]` ascending from the line's start to
+/// its end, pieces alternately visible and hidden starting with `first_visible`; `ids` folds
+/// which polynomial makes each interior break (closed form; 0 otherwise).
+pub(super) struct Line<T> {
+    pub(super) breaks: [T; MAX_BREAKS + 2],
+    pub(super) n: usize,
+    pub(super) first_visible: bool,
+    pub(super) ids: u64,
+}
+
+impl<T: Real> Line<T> {
+    pub(super) fn new() -> Self {
+        Self { breaks: [T::ZERO; MAX_BREAKS + 2], n: 0, first_visible: false, ids: 0 }
+    }
+}
+
+/// Buffers for computing one line in closed form, kept between lines.
+pub(super) struct LineScratch<T> {
+    pub(super) polys: Polys<T>,
+    pub(super) candidates: [(T, u64); MAX_CANDIDATES],
+}
+
+impl<T: Real> LineScratch<T> {
+    pub(super) fn new() -> Self {
+        Self { polys: Polys::new(), candidates: [(T::ZERO, 0u64); MAX_CANDIDATES] }
+    }
+}
+
+/// Most candidate switches gathered on one line.
+pub(super) const MAX_CANDIDATES: usize = 2 * MAX_POLYS;
+
+/// The visibility structure of the line t ∈ [t0, t1] from its polynomials: the candidate
+/// switches are their real roots; each piece between consecutive candidates is classified by
+/// the exact test at its midpoint, and equal neighbours merged. `false` if there are too many.
+pub(super) fn closed_form_line<T: Real>(
+    polys: &[[T; 3]],
+    t0: T,
+    t1: T,
+    vis_at: &impl Fn(T) -> bool,
+    candidates: &mut [(T, u64); MAX_CANDIDATES],
+    line: &mut Line<T>,
+) -> bool {
+    let mut n = 0usize;
+    let mut overflow = false;
+    for (id, &[a, b, c]) in polys.iter().enumerate() {
+        crate::visibility::polynomial_roots(a, b, c, &mut |t| {
+            if t > t0 && t < t1 {
+                match candidates.get_mut(n) {
+                    Some(slot) => {
+                        *slot = (t, id as u64 + 1);
+                        n += 1;
+                    }
+                    None => overflow = true,
+                }
+            }
+        });
+    }
+    if overflow {
+        return false;
+    }
+    let used = candidates.get_mut(..n).unwrap_or_default();
+    sort_by_position(used);
+    line.n = 0;
+    line.ids = 0;
+    let mut lo = t0;
+    let mut lo_id = 0u64;
+    let mut status: Option<bool> = None;
+    // Candidates closer than this are one switch (two polynomials with a common root, e.g. a
+    // facing test and the tangent plane of a sphere occluder the point lies on): the piece
+    // between them is rounding, and the switch gets the smallest of their ids, so that the
+    // line's structure does not change with which root rounds first.
+    let merge = (t1 - t0) * end_inset::<T>();
+    for &(hi, hi_id) in used.iter().chain(core::iter::once(&(t1, 0u64))) {
+        if !(hi > lo + merge) {
+            lo_id = lo_id.min(hi_id);
+            continue;
+        }
+        let v = vis_at((lo + hi) * T::HALF);
+        match status {
+            None => {
+                line.first_visible = v;
+                if push(&mut line.breaks, &mut line.n, t0).is_err() {
+                    return false;
+                }
+            }
+            Some(prev) if prev != v => {
+                if push(&mut line.breaks, &mut line.n, lo).is_err() {
+                    return false;
+                }
+                line.ids = line.ids.wrapping_mul(MAX_POLYS as u64 + 1).wrapping_add(lo_id);
+            }
+            Some(_) => {}
+        }
+        status = Some(v);
+        lo = hi;
+        lo_id = hi_id;
+    }
+    if status.is_none() {
+        line.first_visible = vis_at((t0 + t1) * T::HALF);
+        if push(&mut line.breaks, &mut line.n, t0).is_err() {
+            return false;
+        }
+    }
+    push(&mut line.breaks, &mut line.n, t1).is_ok()
+}
+
+/// (q(x))² for a quadratic q, as quartic coefficients (ascending powers).
+pub(super) fn square<T: Real>(q: &[T; 3]) -> [T; 5] {
+    product(q, q)
+}
+
+/// p(x)·q(x) for two quadratics, as quartic coefficients (ascending powers).
+pub(super) fn product<T: Real>(p: &[T; 3], q: &[T; 3]) -> [T; 5] {
+    let mut out = [T::ZERO; 5];
+    for (i, &a) in p.iter().enumerate() {
+        for (j, &b) in q.iter().enumerate() {
+            if let Some(o) = out.get_mut(i + j) {
+                *o += a * b;
+            }
+        }
+    }
+    out
+}
+
+/// Horner evaluation of Σ c_k x^k.
+pub(super) fn horner<T: Real>(c: &[T], x: T) -> T {
+    let mut v = T::ZERO;
+    for &k in c.iter().rev() {
+        v = v * x + k;
+    }
+    v
+}
+
+/// Passes the real roots in (x0, x1) of Σ c_k x^k (degree ≤ 4) where the polynomial changes
+/// sign: the roots of its derivative split (x0, x1) into monotone pieces, each bisected.
+pub(super) fn roots_in_interval<T: Real>(c: &[T; 5], x0: T, x1: T, out: &mut dyn FnMut(T)) {
+    let degree = c.iter().rposition(|&k| k != T::ZERO).unwrap_or(0);
+    if degree <= 2 {
+        let g = |k: usize| c.get(k).copied().unwrap_or(T::ZERO);
+        crate::visibility::polynomial_roots(g(2), g(1), g(0), &mut |x| {
+            if x > x0 && x < x1 {
+                out(x);
+            }
+        });
+        return;
+    }
+    // Critical points: roots of the derivative (degree ≤ 3), recursively.
+    let mut derivative = [T::ZERO; 5];
+    for (k, d) in derivative.iter_mut().enumerate().take(degree) {
+        *d = c.get(k + 1).copied().unwrap_or(T::ZERO) * T::from_usize(k + 1);
+    }
+    let mut critical = [x0; 6];
+    let mut nc = 1usize;
+    roots_in_interval(&derivative, x0, x1, &mut |x| {
+        if let Some(slot) = critical.get_mut(nc) {
+            *slot = x;
+            nc += 1;
+        }
+    });
+    if let Some(slot) = critical.get_mut(nc) {
+        *slot = x1;
+        nc += 1;
+    }
+    let pts = critical.get_mut(..nc).unwrap_or_default();
+    sort(pts);
+    let coeffs = c.get(..=degree).unwrap_or_default();
+    for w in pts.windows(2) {
+        let (mut lo, mut hi) = match w {
+            [lo, hi] => (*lo, *hi),
+            _ => continue,
+        };
+        let (f_lo, f_hi) = (horner(coeffs, lo), horner(coeffs, hi));
+        if f_lo == T::ZERO && lo > x0 {
+            out(lo);
+        }
+        if !((f_lo < T::ZERO && f_hi > T::ZERO) || (f_lo > T::ZERO && f_hi < T::ZERO)) {
+            continue;
+        }
+        let rising = f_hi > T::ZERO;
+        for _ in 0..(T::MANTISSA_DIGITS + 4) {
+            let mid = (lo + hi) * T::HALF;
+            if mid <= lo || mid >= hi {
+                break;
+            }
+            if (horner(coeffs, mid) > T::ZERO) == rising {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        out((lo + hi) * T::HALF);
+    }
+}
