@@ -1,9 +1,9 @@
 //! Adjacency from the geometry: which edges or corners two patches share, exactly or nearly,
-//! and the gap of a near contact ([`classify`], [`classify_near`]).
+//! and the gap of a near contact ([`classify()`], [`classify_near`]).
 
 use super::*;
 
-/// How two patches touch, as found by [`classify`].
+/// How two patches touch, as found by [`classify()`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Adjacency {
@@ -63,7 +63,7 @@ where
 /// of corners (not e.g. two parallel patches facing each other at a small distance).
 pub const NEAR_CONTACT: f64 = 0.02;
 
-/// Like [`classify`], but corners closer than [`NEAR_CONTACT`] × the shortest edge also count as
+/// Like [`classify()`], but corners closer than [`NEAR_CONTACT`] × the shortest edge also count as
 /// shared; returns the adjacency and the gap (largest distance between matched points, relative
 /// to the patch size — the larger of the two patches' diagonals; 0 up to rounding for patches
 /// that truly touch).
