@@ -1,0 +1,309 @@
+//! Tolerance-driven integration: spend effort only where a pair of patches needs it.
+//!
+//! [`adaptive_exchange`] returns A_a·F_{a→b} with an error estimate, whether that estimate met
+//! the tolerance, and the number of integrand evaluations it took. Per pair it
+//! 1. classifies the pair (`classify_near`): flat pairs that see each other wholly use the
+//!    contour form at two orders or more (where its terms cancel beyond the working precision,
+//!    the paths below take the pair if their rules resolve it, else the contour value stands
+//!    with its rounding bound in the estimate);
+//!    touching pairs use the regularising transforms, raising the order by 2 from 4; the same
+//!    patch twice uses the identical-panel transform (see below);
+//! 2. for separate pairs, starts from an order chosen from the geometry — the Gauss error on an
+//!    integrand whose nearest singularity lies at distance d from patches of size h falls like
+//!    ρ^(−2p) with ρ ≈ 1 + 2d/h, so p₀ = ⌈ln(1/tol) / (2 ln ρ)⌉ (clamped to 2…12);
+//! 3. skips the occlusion tests when no occluder can cut a segment between the two patches'
+//!    bounding balls (`Occluder::may_block_between`), and takes the boundary path
+//!    (`boundary.rs`: visibility boundaries placed into the inner rule, the
+//!    inner patch refined towards close outer points) when the pair straddles a boundary
+//!    (some sample pairs visible, some not, or an occluder that may cut) or the patches are
+//!    closer than their size; the outer patch is chosen as by `pair_exchange`: without
+//!    occluders the patch whose points stay farther from the other's edges
+//!    (`pair::outer_is_b`), across occluders the smaller one (`pair::occluded_outer_is_b`);
+//! 4. compares orders p, p + 2, …; when the estimate is still above the tolerance at
+//!    `max_order`, splits the pair and recurses — a separate pair's larger patch in two across
+//!    its longer side, a touching pair's both patches 2 × 2 (so that the cells along the
+//!    contact share whole edges and corners again) — to depth ≤ `max_depth` (no
+//!    allocation). Sides are
+//!    measured by arc length (a 12-segment polyline along each edge and the mid-line of the
+//!    parameter rectangle), so a side that closes on itself — the θ side of a whole disk or
+//!    cylinder, whose corner chord is zero — is halved like any other.
+//!
+//! # The error estimate and `converged`
+//! Each leaf pair's estimate is a difference between independent approximations, times a
+//! safety factor where the convergence is only algebraic, plus a rounding allowance of
+//! 128 ε·|value| (2.8e-14 relative in f64, 1.5e-5 in f32); the total is the sum over the
+//! leaves. [`Estimate::converged`] is `true` if every leaf met the tolerance (estimate ≤
+//! tolerance·|value|, or value and estimate both zero) or the total estimate meets it against
+//! the total value; at the depth limit, or where a split would go below the resolution of the
+//! coordinates (f32 cells far from the origin), the best value is returned with its estimate
+//! and `converged = false` — never silently above the tolerance, and never an error after
+//! the work. A tolerance below 256 ε (5.7e-14
+//! in f64, 3.1e-5 in f32) is below what any estimate can show: the refinement works to 256 ε
+//! instead (it would otherwise split every pair to the depth limit, for minutes, without
+//! getting closer) and the result says `converged = false` unless its estimate meets the
+//! tolerance asked for. A caller who needs the tolerance checks the flag (or compares `error` with
+//! its own budget).
+//!
+//! * Smooth separate pairs and touching pairs (exponential convergence in the order): with
+//!   d₂ the difference between the last two orders and d₁ the one before, max(d₂, √(d₁·d₂))
+//!   (d₂ alone on a separate pair's first comparison, whose start order the geometry chose);
+//!   touching pairs compare at least three orders. The geometric mean covers convergence that
+//!   stalls for a step (checked against closed forms and the contour integral in the tests).
+//! * Flat pairs by the contour form: the difference between orders 8 and 16 (then 24, 32
+//!   until it meets the tolerance: the contour's 1-D rules are not bound by `max_order`) plus
+//!   the bound on the rounding of the cancelling terms.
+//! * Pairs across visibility boundaries: the outer integrand keeps kinks (a shadow edge meeting
+//!   an inner edge), so successive orders — and a patch and its halves — can agree by
+//!   accident. Four approximations are computed: the outer patch whole and split 2 × 2, each
+//!   at orders p and p + 1 (both levels refined: the inner rule's order is the outer one's);
+//!   the split at p + 1 is returned, and the estimate is 2 × the largest difference between
+//!   the split at p + 1 and the other three and between the split at p and the two wholes.
+//!   On 432 (geometry, order) cases with a cylinder occluder (parallel squares, walls inside
+//!   a coaxial tube; references in closed form up to a 1-D integral) the largest |actual
+//!   error| / difference is 1.01 outside the rounding level, hence the factor 2.
+//! * The same patch twice (`Adjacency::Identical`) by the identical-panel transform
+//!   (`singular.rs`): without an occluder that may cut the patch's view of itself, as a
+//!   touching pair (orders 4, 6, …, both copies split 2 × 2 at `max_order`; a quarter of a
+//!   tube's inside meets 1e-10 with 2.2e5 evaluations). With one, the shadow makes the
+//!   integrand jump, and on a saddle the facing test puts kinks in it; the convergence is then
+//!   algebraic: the value at p = `max_order` with 2 × the
+//!   largest difference from orders p − 1, p − 2, p − 3 and p/2, not split (splitting a self
+//!   pair that an occluder cuts multiplies the touching sub-pairs at every level); above the
+//!   tolerance it says so with `converged = false` (three quarters of a tube's inside around
+//!   a coaxial tube: 2.3e-6 actual against an estimate of 4.8e-4).
+//!
+//! * Self and edge pairs whose contact reaches a side collapsed to a point (a cone's apex)
+//!   converge only algebraically (`singular.rs`): the same five-order estimate as an
+//!   occluded self pair, not split (the cells at the apex stay algebraic at every level).
+//!
+//! # Settings
+//! `tolerance` must be positive and finite, `max_order` in 8..=[`MAX_ORDER`](crate::MAX_ORDER)
+//! and `max_depth` ≤ [`MAX_DEPTH`]; anything else is `Err(InvalidSetting)`, checked before any
+//! work. The sample buffers hold at most `max_order`² points, so `CAP` ≥ `max_order`²
+//! (`Err(CapacityExceeded)` otherwise, also checked first).
+//!
+//! Files: the settings, the entry point and the recursion here; `leaves.rs` (leaf estimates),
+//! `separate.rs` (separate pairs), `split.rs` (splitting).
+
+use crate::error::PdmError;
+use crate::estimate::Estimate;
+use crate::form_factor::exchange_unchecked;
+use crate::integrand::mutually_facing;
+use crate::patch::Patch;
+use crate::real::Real;
+use crate::samples::PatchSamples;
+use crate::singular::{classify_near, touching_evaluations, touching_unchecked, Adjacency};
+use crate::surface::{ParamRect, Surface};
+use crate::visibility::Occluder;
+
+mod leaves;
+mod separate;
+mod split;
+use leaves::*;
+use separate::*;
+pub(crate) use split::*;
+
+/// Largest accepted `max_depth`: at most 2^24 halvings deep. The recursion keeps no sample
+/// buffer on the stack: they live in non-inlined frames that return before it recurses.
+pub const MAX_DEPTH: u32 = 24;
+
+/// Smallest accepted `max_order` (touching pairs compare orders 4, 6 and 8).
+const MIN_ORDER: usize = 8;
+
+/// Factor on the differences that estimate algebraically converging pairs (module docs).
+const SAFETY: f64 = 2.0;
+
+/// Rounding allowance on each leaf, in units of ε·|value|.
+const ROUNDING: f64 = 128.0;
+
+/// The smallest relative tolerance the refinement works to, in units of ε (twice the rounding
+/// allowance, so that a leaf can meet it): 5.7e-14 in f64, 3.1e-5 in f32.
+const PRECISION_FLOOR: f64 = 2.0 * ROUNDING;
+
+/// Settings of the tolerance-driven mode (validated by [`adaptive_exchange`]; see the module
+/// docs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Adaptive<T> {
+    /// Relative tolerance on each pair's exchange A_a·F_{a→b}: positive and finite. Below
+    /// 256 ε (5.7e-14 in f64, 3.1e-5 in f32) the refinement works to 256 ε instead (the
+    /// rounding allowance of every estimate, 128 ε, leaves nothing finer to reach), and the
+    /// result has `converged = false` unless its estimate happens to meet the tolerance.
+    pub tolerance: T,
+    /// Largest Gauss order before a pair is subdivided instead: 8..=`MAX_ORDER` (32). `CAP` must
+    /// be ≥ `max_order`².
+    pub max_order: usize,
+    /// Largest number of successive subdivisions of a pair: ≤ [`MAX_DEPTH`].
+    pub max_depth: u32,
+}
+
+impl<T: Real> Adaptive<T> {
+    /// `tolerance` with max order 12 and max depth 6 (`CAP` ≥ 144).
+    #[must_use]
+    pub fn new(tolerance: T) -> Self {
+        Self { tolerance, max_order: 12, max_depth: 6 }
+    }
+
+    /// `Ok` if every setting is in range (module docs), `Err(InvalidSetting)` naming the first
+    /// that is not.
+    pub fn validate(&self) -> Result<(), PdmError> {
+        if !(self.tolerance > T::ZERO && self.tolerance.is_finite()) {
+            return Err(PdmError::InvalidSetting { name: "tolerance", expected: "positive and finite" });
+        }
+        if !(MIN_ORDER..=crate::gauss::MAX_ORDER).contains(&self.max_order) {
+            return Err(PdmError::InvalidSetting { name: "max_order", expected: "in 8..=32 (MAX_ORDER)" });
+        }
+        if self.max_depth > MAX_DEPTH {
+            return Err(PdmError::InvalidSetting { name: "max_depth", expected: "at most 24 (adaptive::MAX_DEPTH)" });
+        }
+        Ok(())
+    }
+}
+
+/// A partial result inside the tolerance mode: a value, its error estimate (always present),
+/// whether it met the tolerance, and its cost. [`adaptive_exchange`] returns it as an
+/// [`Tally`] with `error: Some(_)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Tally<T> {
+    value: T,
+    error: T,
+    converged: bool,
+    evaluations: u64,
+}
+
+impl<T: Real> Tally<T> {
+    /// A leaf's estimate: `difference` (already scaled) plus the rounding allowance; converged
+    /// if within `tol`.
+    fn leaf(value: T, difference: T, tol: T, evaluations: u64) -> Self {
+        let error = difference.abs() + T::from_f64(ROUNDING) * T::EPSILON * value.abs();
+        let converged = error <= tol * value.abs() || error <= T::MIN_POSITIVE;
+        Self { value, error, converged, evaluations }
+    }
+
+    fn zero(evaluations: u64) -> Self {
+        Self { value: T::ZERO, error: T::ZERO, converged: true, evaluations }
+    }
+
+    fn add(&mut self, other: Self) {
+        self.value += other.value;
+        self.error += other.error;
+        self.converged &= other.converged;
+        self.evaluations = self.evaluations.saturating_add(other.evaluations);
+    }
+}
+
+/// A_a·F_{a→b} to relative tolerance `settings.tolerance`, with an error estimate and a
+/// `converged` flag (see the module docs: check [`Estimate::converged`] — at the depth limit
+/// the value is returned with `converged = false`). `CAP` ≥ `max_order`²; invalid settings are
+/// `Err(InvalidSetting)`, a smaller `CAP` `Err(CapacityExceeded)`, both before any work. The
+/// value is checked against 0 ≤ A_a·F_{a→b} ≤ min(A_a, A_b) (`Err(InvalidResult)` otherwise).
+///
+/// ```
+/// use pdm_kernel::{adaptive_exchange, vec3, Adaptive, Parallelogram, Patch};
+/// // Unit squares 1 apart (C-11: 0.1998248956983874) to a relative tolerance of 1e-8.
+/// let floor = Parallelogram::new(vec3(0.0, 0.0, 0.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0))?;
+/// let ceiling = Parallelogram::new(vec3(0.0, 0.0, 1.0), vec3(0.0, 1.0, 0.0), vec3(1.0, 0.0, 0.0))?;
+/// let (a, b) = (Patch::whole(&floor)?, Patch::whole(&ceiling)?);
+/// let e = adaptive_exchange::<f64, _, _, _, 144>(&a, &b, Adaptive::new(1e-8), &())?;
+/// assert!(e.converged, "check it: false means the tolerance was not met");
+/// let error = e.error.expect("the tolerance mode always estimates its error");
+/// assert!(error <= 1e-8 * e.value);
+/// assert!((e.value - 0.1998248956983874).abs() <= error); // A_a = 1
+/// # Ok::<(), pdm_kernel::PdmError>(())
+/// ```
+pub fn adaptive_exchange<T, SA, SB, O, const CAP: usize>(
+    a: &Patch<'_, T, SA>,
+    b: &Patch<'_, T, SB>,
+    settings: Adaptive<T>,
+    occluders: &O,
+) -> Result<Estimate<T>, PdmError>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
+    settings.validate()?;
+    let needed = settings.max_order * settings.max_order;
+    if needed > CAP {
+        return Err(PdmError::CapacityExceeded { needed, capacity: CAP });
+    }
+    // Every leaf's estimate carries the rounding allowance ROUNDING·ε·|value|, so a leaf can
+    // meet only a tolerance above it: below, the refinement would split every pair down to
+    // `max_depth` without ever getting closer. It works to the precision floor instead, and
+    // the result then says whether the tolerance asked for was met (it cannot be).
+    let floor = T::from_f64(PRECISION_FLOOR) * T::EPSILON;
+    let work = Adaptive { tolerance: settings.tolerance.max(floor), ..settings };
+    // Closed patches are cut at their seams first, as in `pair_exchange`.
+    let mut e = Tally::zero(0);
+    crate::pair::for_each_piece_pair(a, b, |pa, pb| {
+        e.add(recurse::<T, SA, SB, O, CAP>(pa, pb, work, occluders, 0)?);
+        Ok(())
+    })?;
+    let (area_a, area_b) = (a.area(settings.max_order)?, b.area(settings.max_order)?);
+    // The leaves are unchecked approximations: the total may overshoot [0, min(A_a, A_b)] by
+    // its error, and is clamped there; beyond its error it is refused.
+    e.value = crate::bounds::exchange_within(e.value, e.error, area_a, area_b)?;
+    // The leaves judge their own estimates against their own values; a leaf of a tiny value
+    // may miss that while the total meets the tolerance asked for (the pieces of a whole disk
+    // far from the other's rim): the sum of the estimates bounds the total's error.
+    e.converged |= e.error <= work.tolerance * e.value.abs();
+    e.converged &= work.tolerance == settings.tolerance || e.error <= settings.tolerance * e.value.abs();
+    Ok(Estimate { value: e.value, error: Some(e.error), converged: e.converged, evaluations: e.evaluations })
+}
+
+fn recurse<T, SA, SB, O, const CAP: usize>(
+    a: &Patch<'_, T, SA>,
+    b: &Patch<'_, T, SB>,
+    settings: Adaptive<T>,
+    occluders: &O,
+    depth: u32,
+) -> Result<Tally<T>, PdmError>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
+    let (adjacency, gap) = classify_near(a, b);
+    // Two flat patches that see each other wholly: the contour form at two orders.
+    #[cfg(feature = "closed-form")]
+    if crate::pair::contour_applies(adjacency) {
+        let lo_order = 8usize.min(settings.max_order);
+        // Where the contour terms cancel beyond the working precision (f32 cells close
+        // together) or the gap is below the geometry's resolution (`Unresolvable`), the 4-D
+        // path below takes the pair instead if its Gauss rules resolve the pair at
+        // `max_order`; otherwise (long strips close together, whose ends no node comes near)
+        // two approximations can agree on a wrong value: the contour value stands with its
+        // rounding bound in the estimate, and the refusal of an unresolvable gap stands.
+        match contour_leaf(a, b, lo_order, settings, occluders) {
+            Some(Err(PdmError::Unresolvable))
+                if adjacency != Adjacency::Separate
+                    || crate::pair::resolved::<T, SA, SB, CAP>(a, b, settings.max_order)? => {}
+            Some(Ok((_, true)))
+                if adjacency != Adjacency::Separate
+                    || crate::pair::resolved::<T, SA, SB, CAP>(a, b, settings.max_order)? => {}
+            None => {}
+            Some(result) => return result.map(|(estimate, _)| estimate),
+        }
+    }
+    if crate::singular::contact_reaches_collapsed_side(a, b, adjacency) {
+        return collapsed_contact::<T, SA, SB, O>(a, b, adjacency, gap, settings, occluders);
+    }
+    match adjacency {
+        Adjacency::SharedEdge { .. } | Adjacency::SharedVertex { .. } => {
+            // The transforms test occlusion only at their sample points: with an occluder that
+            // may cut the pair, successive orders can agree on a wrong value. Split both patches 2 × 2 until no occluder can cut a touching sub-pair;
+            // the separate sub-pairs take the boundary-aware path.
+            if depth < settings.max_depth && occluders.may_block_between(&a.enclosing_ball(), &b.enclosing_ball()) {
+                return split_both::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, 0);
+            }
+            let eval = |p: usize| {
+                Ok((touching_unchecked(a, b, adjacency, gap, p, occluders)?, touching_evaluations(adjacency, p)))
+            };
+            by_order_doubling::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, eval, 4, Split::Both)
+        }
+        Adjacency::Identical => identical::<T, SA, O, CAP>(a, settings, occluders, depth),
+        Adjacency::Separate => separate::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth),
+    }
+}

@@ -1,0 +1,207 @@
+//! Choices on the boundary path: whether a pair is near or resolved by the 4-D rule, and which
+//! patch goes outside (independent of the argument order).
+
+use super::*;
+
+/// `true` if two patches are closer than the larger one's radius: the plain rule's error then
+/// falls slowly with the order (the kernel's nearest singularity is within a patch size), and the
+/// boundary path, which refines the inner patch towards each outer point, takes the pair.
+pub(crate) fn near<T: Real>(a: &crate::samples::Ball<T>, b: &crate::samples::Ball<T>) -> bool {
+    (a.center - b.center).norm() - a.radius - b.radius < a.radius.max(b.radius)
+}
+
+/// Whether the Gauss rules of order `order` resolve the pair
+/// ([`crate::form_factor::samples_resolved`]).
+#[cfg(feature = "closed-form")]
+pub(crate) fn resolved<T, SA, SB, const CAP: usize>(
+    a: &Patch<'_, T, SA>,
+    b: &Patch<'_, T, SB>,
+    order: usize,
+) -> Result<bool, PdmError>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+{
+    let sa = PatchSamples::<T, CAP>::new(a, order)?;
+    let sb = PatchSamples::<T, CAP>::new(b, order)?;
+    Ok(crate::form_factor::samples_resolved(&sa, order, &sb, order))
+}
+
+/// Which patch of a pair an occluder may cut the boundary path should integrate outside
+/// (`true`: b). The inner rule is in closed form only on a flat (affine) inner patch: when only
+/// one of the two is flat, it goes inside. Otherwise the smaller one (enclosing ball) goes
+/// outside: the outer integrand kinks where a shadow boundary on the inner patch meets that
+/// patch's corners and edges, and jumps where an occluder cuts the outer patch itself; on the
+/// larger inner patch a shadow more often lies wholly inside, and the smaller outer patch is
+/// less often cut. It also makes the choice independent of the argument order.
+pub(crate) fn occluded_outer_is_b<T, SA, SB>(a: &Patch<'_, T, SA>, b: &Patch<'_, T, SB>) -> bool
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+{
+    let (flat_a, flat_b) = (has_affine_map(a), has_affine_map(b));
+    if flat_a != flat_b {
+        return flat_a;
+    }
+    b.enclosing_ball().radius < a.enclosing_ball().radius
+}
+
+/// Which patch of a separate, unoccluded pair the boundary path should integrate outside
+/// (`true`: b). The outer integrand is smooth where every outer point sees part of the inner
+/// patch; where some see none of it, the support's edge is a kink curve across the outer
+/// patch: the patch with fewer blind sample points goes outside. On a tie, where an outer
+/// point comes closer to the inner patch's edges than the outer rule's node spacing, the
+/// inner integral changes on that distance's scale there (a disk 0.05 below a larger one:
+/// across the small disk's rim), which the outer rule cannot resolve: the patch whose points
+/// stay farther from the other's edges, in its own node spacings, goes outside (the small
+/// disk over the large one). Otherwise the flat one (a curved outer patch sweeps its tangent
+/// plane across the inner one, which adds kinks; a flat one does not).
+pub(crate) fn outer_is_b<T, SA, SB, const CAP: usize>(
+    a: &Patch<'_, T, SA>,
+    b: &Patch<'_, T, SB>,
+    sa: &PatchSamples<T, CAP>,
+    sb: &PatchSamples<T, CAP>,
+) -> bool
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+{
+    // Very near (`boundary::very_near`) with exactly one patch flat: the flat one goes inside.
+    // A point of the curved patch sees the flat one cut by one plane (its tangent plane), which
+    // the inner rule places in closed form or brackets as a line; a point of the flat patch may
+    // see only a small cap of the curved one (a sphere cell 1e-3 above a plate: a cap of radius
+    // √(2·R·gap)), which a probe grid misses. The blind-point count below is a sample count
+    // that changes with the order on such a pair.
+    if is_flat(a) != is_flat(b) && crate::boundary::very_near(a, b).unwrap_or(false) {
+        return is_flat(a);
+    }
+    let (blind_a, blind_b) = (blind_points(sa, sb), blind_points(sb, sa));
+    if blind_a != blind_b {
+        return blind_b < blind_a;
+    }
+    let (clear_a, clear_b) = (edge_clearance(sa, b), edge_clearance(sb, a));
+    if clear_a.min(clear_b) < T::ONE && clear_a != clear_b {
+        return clear_b > clear_a;
+    }
+    is_flat(b) && !is_flat(a)
+}
+
+/// Segments per edge of the polylines that stand for a patch's edges in [`edge_clearance`].
+pub(super) const EDGE_SEGMENTS: usize = 16;
+
+/// The smallest distance from a sample of `outer` to the edges of `inner` (16-segment
+/// polylines), in node spacings of the outer rule (its sample ball's diameter / order).
+pub(super) fn edge_clearance<T, S, const CAP: usize>(outer: &PatchSamples<T, CAP>, inner: &Patch<'_, T, S>) -> T
+where
+    T: Real,
+    S: Surface<T> + ?Sized,
+{
+    let r = inner.rect();
+    let g = inner.surface();
+    let n = T::from_usize(EDGE_SEGMENTS);
+    let edge_point = |edge: usize, k: usize| {
+        let x = T::from_usize(k) / n;
+        let (t, s) = match edge {
+            0 => (r.t0 + (r.t1 - r.t0) * x, r.s0),
+            1 => (r.t1, r.s0 + (r.s1 - r.s0) * x),
+            2 => (r.t0 + (r.t1 - r.t0) * x, r.s1),
+            _ => (r.t0, r.s0 + (r.s1 - r.s0) * x),
+        };
+        g.point(t, s)
+    };
+    let mut nearest = T::MAX;
+    for edge in 0..4 {
+        let mut prev = edge_point(edge, 0);
+        for k in 1..=EDGE_SEGMENTS {
+            let next = edge_point(edge, k);
+            let d = next - prev;
+            let d2 = d.dot(d);
+            for p in outer.iter() {
+                let w = p.point - prev;
+                let along = if d2 > T::ZERO { (w.dot(d) / d2).max(T::ZERO).min(T::ONE) } else { T::ZERO };
+                nearest = nearest.min((w - d.scale(along)).norm());
+            }
+            prev = next;
+        }
+    }
+    let order = T::from_usize(outer.len()).sqrt().max(T::ONE);
+    let spacing = outer.bounds().radius * T::TWO / order;
+    if spacing > T::ZERO {
+        nearest / spacing
+    } else {
+        T::MAX
+    }
+}
+
+/// How many samples of `outer` see no sample of `inner` through the two-sided facing test
+/// (section 3.2): points where the inner integral of the boundary path would vanish.
+pub(super) fn blind_points<T: Real, const CAP: usize>(
+    outer: &PatchSamples<T, CAP>,
+    inner: &PatchSamples<T, CAP>,
+) -> usize {
+    outer
+        .iter()
+        .filter(|p| !inner.iter().any(|q| mutually_facing(p.point, p.unit_normal, q.point, q.unit_normal)))
+        .count()
+}
+
+/// The boundary path with the outer patch split `OCCLUDED_OUTER_SPLIT`²: shadow edges
+/// crossing b make the outer integrand kink where they touch b's edges.
+pub(super) fn occluded<T, SA, SB, O, const CAP: usize>(
+    a: &Patch<'_, T, SA>,
+    b: &Patch<'_, T, SB>,
+    order: usize,
+    occluders: &O,
+) -> Result<(T, u64), PdmError>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
+    let (mut total, mut count) = (T::ZERO, 0u64);
+    let r = a.rect();
+    let n = OCCLUDED_OUTER_SPLIT;
+    for k in 0..n * n {
+        let child = Patch::new(a.surface(), r.cell(k / n, k % n, n, n))?;
+        let (v, c, _, _) = boundary_unchecked::<T, SA, SB, O, CAP>(&child, b, order, occluders)?;
+        total += v;
+        count = count.saturating_add(c);
+    }
+    Ok((total, count))
+}
+
+/// Whether the patch's surface is a parallelogram (an affine map), which the boundary path
+/// integrates in closed form as the inner patch.
+pub(super) fn has_affine_map<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>) -> bool {
+    #[cfg(feature = "closed-form")]
+    return p.surface().affine_map().is_some();
+    #[cfg(not(feature = "closed-form"))]
+    {
+        let _ = p;
+        false
+    }
+}
+
+/// Whether the patch is flat: its unit normals at the centre and near the four corners agree to
+/// rounding (a parallelogram, a disk or annulus sector, a planar Bézier patch).
+pub(super) fn is_flat<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>) -> bool {
+    let r = p.rect();
+    let g = p.surface();
+    let at = |x: T, y: T| {
+        let n = g.normal(r.t0 + (r.t1 - r.t0) * x, r.s0 + (r.s1 - r.s0) * y);
+        let length = n.norm();
+        if length > T::ZERO && length.is_finite() {
+            Some(n.scale(T::ONE / length))
+        } else {
+            None
+        }
+    };
+    let (lo, hi) = (T::from_f64(0.125), T::from_f64(0.875));
+    let Some(centre) = at(T::HALF, T::HALF) else { return false };
+    let limit = T::ONE - T::from_f64(64.0) * T::EPSILON;
+    [(lo, lo), (hi, lo), (lo, hi), (hi, hi)].iter().all(|&(x, y)| at(x, y).is_some_and(|n| n.dot(centre) >= limit))
+}

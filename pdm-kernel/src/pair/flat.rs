@@ -1,0 +1,101 @@
+//! Two flat patches that see each other wholly: the contour form (parallelograms in closed form,
+//! curved outlines by graded rules).
+
+use super::*;
+
+/// Whether a pair of the given contact may take the contour form (if both patches are flat
+/// and see each other wholly, [`flat_pair`]): separate, nearly touching and touching pairs —
+/// along a shared edge the collinear edge term is the closed form at η = 0, whose logarithm
+/// the outer rule's grading towards the edge's ends integrates (C-14 at order 12 to 3e-16 with
+/// 672 line evaluations, where the edge transform needs 6·p⁴), and a partial shared edge (a
+/// short edge lying along a longer one from a common corner, a non-conforming grid) is
+/// covered the same way. The same patch twice takes the identical-panel transform.
+#[cfg(feature = "closed-form")]
+pub(crate) fn contour_applies(adjacency: Adjacency) -> bool {
+    adjacency != Adjacency::Identical
+}
+
+/// Two flat patches that see each other wholly — each in the closed half-space in front of the
+/// other, not coplanar, no occluder able to cut a segment between them — by the contour form
+/// ([`crate::contour`]: parallelograms in closed form along the inner edge, curved edges by
+/// graded rules), exponential at any gap and aspect ratio; `None` if the pair is not such a
+/// pair. Gives the value, the evaluations and a bound on the value's rounding error (the
+/// caller refuses values that lost half their digits, [`crate::bounds::lost_digits`]).
+#[cfg(feature = "closed-form")]
+pub(crate) fn flat_pair<'p, 'r, T, SA, SB, O>(
+    a: &Patch<'p, T, SA>,
+    b: &Patch<'r, T, SB>,
+    order: usize,
+    occluders: &O,
+) -> Option<Result<(T, u64, T), PdmError>>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
+    // Parallelograms by their corners, other flat patches by their outlines; each wholly in
+    // front of (or on) the other's plane, and not both in one plane.
+    let (shape, b_ahead, a_ahead, cos) = if let (Some((ca, na)), Some((cb, nb))) = (flat_corners(a), flat_corners(b)) {
+        let size = ca.iter().chain(cb.iter()).fold(T::ZERO, |m, &p| m.max((p - ca[0]).norm()));
+        let band = size * T::GEOMETRY_TOLERANCE;
+        let side = |corners: &[Vec3<T>; 4], origin: Vec3<T>, n: Vec3<T>| {
+            let mut ahead = false;
+            for &q in corners {
+                let h = n.dot(q - origin);
+                if h < -band {
+                    return None;
+                }
+                ahead |= h > band;
+            }
+            Some(ahead)
+        };
+        (FlatShape::Corners(ca, cb), side(&cb, ca[0], na)?, side(&ca, cb[0], nb)?, na.dot(nb))
+    } else {
+        let oa = crate::contour::Outline::new(a)?;
+        let ob = crate::contour::Outline::new(b)?;
+        let band = oa.size().max(ob.size()) * T::GEOMETRY_TOLERANCE;
+        let (b_ahead, a_ahead) = (ob.ahead_of(oa.origin, oa.normal, band)?, oa.ahead_of(ob.origin, ob.normal, band)?);
+        let cos = oa.normal.dot(ob.normal);
+        (FlatShape::Outlines(oa, ob), b_ahead, a_ahead, cos)
+    };
+    if b_ahead && a_ahead {
+        if occluders.may_block_between(&a.enclosing_ball(), &b.enclosing_ball()) {
+            return None;
+        }
+        let order = order.max(4);
+        return Some(match shape {
+            FlatShape::Corners(ca, cb) => crate::contour::quad_exchange(&ca, &cb, order),
+            FlatShape::Outlines(oa, ob) => crate::contour::curve_exchange(&oa, &ob, order),
+        });
+    }
+    // Each within the other's plane to the working precision while facing each other: a gap
+    // below the geometry's resolution (f32 plates 1e-6 apart), which no path can integrate
+    // (the 4-D rules would return a value off by percents).
+    (!b_ahead && !a_ahead && cos < T::ZERO).then_some(Err(PdmError::Unresolvable))
+}
+
+/// The two flat patches of [`flat_pair`]: parallelograms by their corners (inner line
+/// integrals in closed form), any other flat patches by their outlines.
+#[cfg(feature = "closed-form")]
+pub(super) enum FlatShape<'p, 'r, T: Real, SA: Surface<T> + ?Sized, SB: Surface<T> + ?Sized> {
+    Corners([Vec3<T>; 4], [Vec3<T>; 4]),
+    Outlines(crate::contour::Outline<'p, T, SA>, crate::contour::Outline<'r, T, SB>),
+}
+
+/// A flat patch's corners counter-clockwise about its radiating normal, and its unit normal.
+#[cfg(feature = "closed-form")]
+pub(super) fn flat_corners<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>) -> Option<([Vec3<T>; 4], Vec3<T>)> {
+    let (o, et, es) = p.surface().affine_map()?;
+    let r = p.rect();
+    let at = |t: T, s: T| o + et.scale(t) + es.scale(s);
+    let corners = [at(r.t0, r.s0), at(r.t1, r.s0), at(r.t1, r.s1), at(r.t0, r.s1)];
+    let normal = p.surface().normal((r.t0 + r.t1) * T::HALF, (r.s0 + r.s1) * T::HALF);
+    let length = normal.norm();
+    if !(length > T::ZERO) || !length.is_finite() {
+        return None;
+    }
+    let n = normal.scale(T::ONE / length);
+    let [c0, c1, c2, c3] = corners;
+    Some(if n.dot(et.cross(es)) >= T::ZERO { (corners, n) } else { ([c0, c3, c2, c1], n) })
+}
