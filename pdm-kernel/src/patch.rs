@@ -4,8 +4,8 @@
 use crate::error::PdmError;
 use crate::gauss::GaussRule;
 use crate::real::Real;
-use crate::samples::Ball;
 use crate::surface::{ParamRect, Surface};
+use crate::vec3::Ball;
 
 /// A surface restricted to the parameter rectangle `rect` ⊆ its domain.
 #[derive(Debug)]

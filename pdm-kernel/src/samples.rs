@@ -14,17 +14,8 @@ use crate::gauss::GaussRule;
 use crate::patch::Patch;
 use crate::real::Real;
 use crate::surface::Surface;
+pub use crate::vec3::Ball;
 use crate::vec3::{vec3, Vec3};
-
-/// A ball (centre, radius) bounding a set of points.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct Ball<T> {
-    /// Centre.
-    pub center: Vec3<T>,
-    /// Radius.
-    pub radius: T,
-}
 
 /// Precomputed Gauss samples of one patch (at most `CAP` of them).
 #[derive(Clone, Debug)]

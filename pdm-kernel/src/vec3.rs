@@ -118,6 +118,16 @@ impl<S: Neg<Output = S>> Neg for Vec3<S> {
     }
 }
 
+/// A ball (centre, radius) bounding a set of points.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Ball<T> {
+    /// Centre.
+    pub center: Vec3<T>,
+    /// Radius.
+    pub radius: T,
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
