@@ -93,17 +93,21 @@ where
     if needed > CAP {
         return Err(PdmError::CapacityExceeded { needed, capacity: CAP });
     }
-    let (total, order) = match method {
-        Method::Paper(q) => (paper_rows::<T, SA, SB, O, CAP>(a.clone(), b.clone(), q, occluders)?, q.order_a),
+    // The areas of the total's bounds check: from the samples where the method keeps them (the
+    // paper's sum), else by eq. (12) at the method's order.
+    let (total, area_a, area_b) = match method {
+        Method::Paper(q) => paper_rows::<T, SA, SB, O, CAP>(a, b, q, occluders)?,
         Method::Plain(q) => {
             let (rule_a, rule_b) = (GaussRule::<T>::new(q.order_a)?, GaussRule::<T>::new(q.order_b)?);
-            (plain_total::<T, SA, SB, O, CAP>(a.clone(), b.clone(), &rule_a, &rule_b, occluders)?.0, q.order_a)
+            let (total, area_a) = plain_total::<T, SA, SB, O, CAP>(a, b.clone(), &rule_a, &rule_b, occluders)?;
+            (total, area_a, b.area(q.order_b)?)
         }
         Method::Pair(s) => {
             let pair = |pa: &Patch<'_, T, SA>, pb: &Patch<'_, T, SB>| {
                 pair_exchange::<T, SA, SB, O, CAP>(pa, pb, s, occluders).map(|e| (e, T::ZERO))
             };
-            (sum_pairs(a.clone(), b.clone(), pair)?.0, s.order.max(2))
+            let order = s.order.max(2);
+            (sum_pairs(a.clone(), b.clone(), pair)?.0, a.area(order)?, b.area(order)?)
         }
         Method::Tolerance(s) => {
             let pair = |pa: &Patch<'_, T, SA>, pb: &Patch<'_, T, SB>| {
@@ -115,11 +119,11 @@ where
             if let Some(error) = total.error {
                 total.converged |= error <= s.tolerance * total.value.abs();
             }
-            (total, s.max_order)
+            (total, a.area(s.max_order)?, b.area(s.max_order)?)
         }
     };
     let band = total.error.unwrap_or_else(|| total.value.abs() * T::from_f64(FIXED_BAND));
-    let value = crate::bounds::exchange_within(total.value, band, a.area(order)?, b.area(order)?)?;
+    let value = crate::bounds::exchange_within(total.value, band, area_a, area_b)?;
     Ok(Estimate { value, ..total })
 }
 
@@ -176,14 +180,14 @@ where
 }
 
 /// [`Method::Paper`]: each patch of `a` sampled once, each of `b` once per row; two sample
-/// buffers, in this frame only.
+/// buffers, in this frame only. With A_A and A_B from the samples' weights (eq. 12).
 #[inline(never)]
 fn paper_rows<T, SA, SB, O, const CAP: usize>(
     a: PatchGrid<'_, T, SA>,
     b: PatchGrid<'_, T, SB>,
     q: Quadrature,
     occluders: &O,
-) -> Result<Estimate<T>, PdmError>
+) -> Result<(Estimate<T>, T, T), PdmError>
 where
     T: Real,
     SA: Surface<T> + ?Sized,
@@ -194,17 +198,23 @@ where
     let mut sa = PatchSamples::<T, CAP>::empty();
     let mut sb = PatchSamples::<T, CAP>::empty();
     let (mut value, mut evaluations) = (T::ZERO, 0u64);
+    let (mut area_a, mut area_b, mut first_row) = (T::ZERO, T::ZERO, true);
     for pa in a {
         sa.fill_with_rules(&pa, &rule_a, &rule_a)?;
+        area_a += sa.area();
         let mut row = T::ZERO;
         for pb in b.clone() {
             sb.fill_with_rules(&pb, &rule_b, &rule_b)?;
+            if first_row {
+                area_b += sb.area();
+            }
             row += exchange(&sa, &sb, occluders)?;
             evaluations = evaluations.saturating_add((sa.len() * sb.len()) as u64);
         }
         value += row;
+        first_row = false;
     }
-    Ok(Estimate::fixed(value, evaluations))
+    Ok((Estimate::fixed(value, evaluations), area_a, area_b))
 }
 
 /// A computation generic over the sample capacity, run by [`with_capacity`] with one chosen at
