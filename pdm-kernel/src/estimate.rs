@@ -50,11 +50,4 @@ impl<T: Real> Estimate<T> {
             evaluations: self.evaluations.saturating_add(other.evaluations),
         }
     }
-
-    /// The error estimate relative to the value (`None` without an estimate; the absolute
-    /// estimate when the value is zero).
-    #[must_use]
-    pub fn relative_error(&self) -> Option<T> {
-        self.error.map(|e| if self.value != T::ZERO { e / self.value.abs() } else { e })
-    }
 }

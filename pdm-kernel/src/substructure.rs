@@ -25,8 +25,10 @@ use crate::visibility::Occluder;
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Method<T> {
     /// The paper's method: the PDM sum of eq. (16) at these orders on every pair, touching and
-    /// identical pairs included (Gauss nodes are interior, so L never vanishes; such pairs
-    /// converge only algebraically). What [`crate::form_factor()`] computes, pair by pair.
+    /// identical pairs included (the Gauss nodes are interior, so touching patches never share
+    /// a node; on the same patch twice at equal orders the coinciding nodes fail the facing
+    /// test and drop out). Such pairs converge only algebraically. What
+    /// [`crate::form_factor()`] computes, pair by pair.
     Paper(Quadrature),
     /// The PDM sum where it resolves the pair, [`crate::pair_exchange`] at the same order
     /// where it does not (touching, identical and too close pairs): what
@@ -46,8 +48,10 @@ impl<T: Real> Method<T> {
     #[must_use]
     pub fn capacity(&self) -> usize {
         let order = match self {
-            Self::Paper(q) | Self::Plain(q) => q.order_a.max(q.order_b),
-            Self::Pair(s) => s.order,
+            Self::Paper(q) => q.order_a.max(q.order_b),
+            // The unresolved pairs go to `pair_exchange` at this order, at least 2.
+            Self::Plain(q) => q.order_a.max(q.order_b).max(2),
+            Self::Pair(s) => s.order.max(2),
             Self::Tolerance(s) => s.max_order,
         };
         order.saturating_mul(order)
@@ -57,7 +61,9 @@ impl<T: Real> Method<T> {
 /// A_A·F_{A→B} between the patches of grid `a` and grid `b` by eqs. (25)–(26), each pair by
 /// `method`, with `occluders`: the value, the sum of the pairs' error estimates (tolerance mode
 /// only), whether the tolerance was met, and the evaluations spent. Divide by A_A
-/// ([`PatchGrid::area`]) for F_{A→B}.
+/// ([`PatchGrid::area`], equal to the samples' area up to rounding) for F_{A→B}. The pairs are
+/// added in the grids' order (rows of `a` outer), so the value is the sum of the single-pair
+/// entry points' values in that order, bit for bit.
 ///
 /// Each pair's value is checked by its method (0 ≤ A_pa·F_{pa→pb} ≤ min(A_pa, A_pb)), and the
 /// total against 0 ≤ A_A·F_{A→B} ≤ min(A_A, A_B) with both areas summed over the grids at the
@@ -89,6 +95,9 @@ where
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
+    if let Method::Tolerance(s) = method {
+        s.validate()?;
+    }
     let needed = method.capacity();
     if needed > CAP {
         return Err(PdmError::CapacityExceeded { needed, capacity: CAP });
@@ -113,22 +122,22 @@ where
             let pair = |pa: &Patch<'_, T, SA>, pb: &Patch<'_, T, SB>| {
                 adaptive_exchange::<T, SA, SB, O, CAP>(pa, pb, s, occluders).map(|e| (e, T::ZERO))
             };
-            let mut total = sum_pairs(a.clone(), b.clone(), pair)?.0;
-            // A pair of tiny value may miss the tolerance against itself while the total meets
-            // it: the summed estimates bound the total's error.
-            if let Some(error) = total.error {
-                total.converged |= error <= s.tolerance * total.value.abs();
-            }
-            (total, a.area(s.max_order)?, b.area(s.max_order)?)
+            (sum_pairs(a.clone(), b.clone(), pair)?.0, a.area(s.max_order)?, b.area(s.max_order)?)
         }
     };
     let band = total.error.unwrap_or_else(|| total.value.abs() * T::from_f64(FIXED_BAND));
     let value = crate::bounds::exchange_within(total.value, band, area_a, area_b)?;
-    Ok(Estimate { value, ..total })
+    let mut converged = total.converged;
+    // A pair of tiny value may miss the tolerance against itself while the total meets it: the
+    // summed estimates bound the total's error (judged against the value returned).
+    if let (Method::Tolerance(s), Some(error)) = (method, total.error) {
+        converged |= error <= s.tolerance * value.abs();
+    }
+    Ok(Estimate { value, converged, ..total })
 }
 
 /// Relative overshoot of the physical bounds that a fixed-order total may have as quadrature
-/// error (as on a single pair, `pair.rs`).
+/// error (as on a single pair, `pair/`).
 const FIXED_BAND: f64 = 1e-4;
 
 /// Σ over every pair of `a` × `b` (rows of `a` outer, `b` inner, added in that order) of
@@ -145,7 +154,8 @@ where
     SA: Surface<T> + ?Sized,
     SB: Surface<T> + ?Sized,
 {
-    let mut total = Estimate { value: T::ZERO, error: None, converged: true, evaluations: 0 };
+    // No pair (a grid already iterated to its end): no value, no estimate.
+    let mut total = Estimate::fixed(T::ZERO, 0);
     let mut area_a = T::ZERO;
     let mut first = true;
     for pa in a {
@@ -202,16 +212,14 @@ where
     for pa in a {
         sa.fill_with_rules(&pa, &rule_a, &rule_a)?;
         area_a += sa.area();
-        let mut row = T::ZERO;
         for pb in b.clone() {
             sb.fill_with_rules(&pb, &rule_b, &rule_b)?;
             if first_row {
                 area_b += sb.area();
             }
-            row += exchange(&sa, &sb, occluders)?;
-            evaluations = evaluations.saturating_add((sa.len() * sb.len()) as u64);
+            value += exchange(&sa, &sb, occluders)?;
+            evaluations = evaluations.saturating_add((sa.len() as u64).saturating_mul(sb.len() as u64));
         }
-        value += row;
         first_row = false;
     }
     Ok((Estimate::fixed(value, evaluations), area_a, area_b))

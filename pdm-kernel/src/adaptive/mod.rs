@@ -13,7 +13,7 @@
 //!    ρ^(−2p) with ρ ≈ 1 + 2d/h, so p₀ = ⌈ln(1/tol) / (2 ln ρ)⌉ (clamped to 2…12);
 //! 3. skips the occlusion tests when no occluder can cut a segment between the two patches'
 //!    bounding balls (`Occluder::may_block_between`), and takes the boundary path
-//!    (`boundary.rs`: visibility boundaries placed into the inner rule, the
+//!    (`boundary/`: visibility boundaries placed into the inner rule, the
 //!    inner patch refined towards close outer points) when the pair straddles a boundary
 //!    (some sample pairs visible, some not, or an occluder that may cut) or the patches are
 //!    closer than their size; the outer patch is chosen as by `pair_exchange`: without
@@ -62,7 +62,7 @@
 //!   a coaxial tube; references in closed form up to a 1-D integral) the largest |actual
 //!   error| / difference is 1.01 outside the rounding level, hence the factor 2.
 //! * The same patch twice (`Adjacency::Identical`) by the identical-panel transform
-//!   (`singular.rs`): without an occluder that may cut the patch's view of itself, as a
+//!   (`singular/`): without an occluder that may cut the patch's view of itself, as a
 //!   touching pair (orders 4, 6, …, both copies split 2 × 2 at `max_order`; a quarter of a
 //!   tube's inside meets 1e-10 with 2.2e5 evaluations). With one, the shadow makes the
 //!   integrand jump, and on a saddle the facing test puts kinks in it; the convergence is then
@@ -73,7 +73,7 @@
 //!   a coaxial tube: 2.3e-6 actual against an estimate of 4.8e-4).
 //!
 //! * Self and edge pairs whose contact reaches a side collapsed to a point (a cone's apex)
-//!   converge only algebraically (`singular.rs`): the same five-order estimate as an
+//!   converge only algebraically (`singular/`): the same five-order estimate as an
 //!   occluded self pair, not split (the cells at the apex stay algebraic at every level).
 //!
 //! # Settings
@@ -86,7 +86,7 @@
 //! `separate.rs` (separate pairs), `split.rs` (splitting).
 
 use crate::error::PdmError;
-use crate::estimate::Estimate;
+pub use crate::estimate::Estimate;
 use crate::form_factor::exchange_unchecked;
 use crate::integrand::mutually_facing;
 use crate::patch::Patch;
@@ -162,7 +162,7 @@ impl<T: Real> Adaptive<T> {
 
 /// A partial result inside the tolerance mode: a value, its error estimate (always present),
 /// whether it met the tolerance, and its cost. [`adaptive_exchange`] returns it as an
-/// [`Tally`] with `error: Some(_)`.
+/// [`Estimate`] with `error: Some(_)`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Tally<T> {
     value: T,

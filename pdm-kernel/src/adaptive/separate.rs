@@ -141,7 +141,7 @@ where
 }
 
 /// A pair that a visibility boundary crosses. The boundaries are placed into the inner rule
-/// (`boundary.rs`), but the outer integrand still has kinks where a boundary
+/// (`boundary/`), but the outer integrand still has kinks where a boundary
 /// meets the inner patch's edges, and two Gauss orders can agree there by accident. So the error is estimated from the outer patch whole and split
 /// 2 × 2 at two orders ([`across_leaf`], module docs), and the pair is subdivided further while
 /// the estimate exceeds the tolerance.

@@ -4,7 +4,7 @@
 //!   patch) is first cut at its seam into pieces (`pieces`); every pair of pieces is then
 //!   dispatched as below and the results are summed.
 //! - Two flat patches that see each other wholly, with no occluder able to cut between them,
-//!   use the contour form (`contour.rs`), separate or touching: parallelograms with the inner
+//!   use the contour form (`contour/`), separate or touching: parallelograms with the inner
 //!   line integral in closed form, flat patches with curved edges (disk and annulus sectors,
 //!   planar Bézier patches, a disk against a parallelogram) with graded rules along both
 //!   edges ([`Surface::point_and_partials`]). Exponential in the order at any gap, from far
@@ -13,18 +13,18 @@
 //!   touching pair falls to the transforms below.
 //! - Other touching pairs (shared edge or vertex, found by
 //!   `classify_near`, also when they are only nearly touching) use the
-//!   regularising transforms of `singular.rs`, converging exponentially with
+//!   regularising transforms of `singular/`, converging exponentially with
 //!   `singular_order`.
 //! - A touching pair that an occluder may cut is first split, both patches 2 × 2, until the
 //!   cells along the contact are clear of every occluder (at most `MAX_CONTACT_SPLITS`
 //!   levels): a shadow across the pair would put a jump into the transformed integrand. The
 //!   sub-pairs are dispatched as above and below.
-//! - The same patch twice uses the identical-panel transform of `singular.rs`,
+//! - The same patch twice uses the identical-panel transform of `singular/`,
 //!   converging exponentially with `singular_order` on a smooth patch.
 //! - Other separate pairs use the PDM sum at `order`. With `boundaries` on, a pair that
 //!   straddles a back-face cut, that an occluder may cut, or whose patches are closer than
 //!   their size gets the visibility boundaries placed into the inner rule and the inner patch
-//!   refined towards each outer point (`boundary.rs`; the outer patch is also split
+//!   refined towards each outer point (`boundary/`; the outer patch is also split
 //!   `OCCLUDED_OUTER_SPLIT`² when an occluder may cut); smooth, distant, unoccludable pairs
 //!   keep the plain sum. Without occluders the outer patch is, for a very near pair with one
 //!   flat patch, the curved one; otherwise the one with fewer points that see none of the
@@ -96,7 +96,7 @@ impl PairSettings {
 /// A_a·F_{a→b} for any two patches, by the method the pair needs (see the module docs), as an
 /// [`Estimate`] without an error estimate (`error: None`, `converged: false`: a fixed-order
 /// method) and with the work it did in `evaluations`: kernel evaluations and visibility probes
-/// on the boundary path (`boundary.rs`), order⁴ for a plain sum and order⁴ more for the
+/// on the boundary path (`boundary/`), order⁴ for a plain sum and order⁴ more for the
 /// straddle check, 6·p⁴ for a shared edge and 4·p⁴ for a shared vertex (p = `singular_order`),
 /// 4·p⁴ for a self pair (times the ζ-shells of long patches).
 ///
@@ -129,7 +129,7 @@ impl PairSettings {
 ///   integrand has a layer on the scale of the gap (a peak under the closest point, a step
 ///   where one patch passes over the other's edge). The boundary path cuts the outer patch
 ///   into up to 32 cells graded towards the inner one and puts a flat patch inside
-///   (`boundary.rs`); a sphere cell of radius 0.3 whose lowest point is 1e-1, 3e-2 or
+///   (`boundary/`); a sphere cell of radius 0.3 whose lowest point is 1e-1, 3e-2 or
 ///   1e-3 above a plate cell near its corner: 6.0e-9 / 1.3e-9 / 1.3e-8 at order 12, 8.3e-10 /
 ///   9.3e-10 / 7.4e-9 at 16 (test `trust::sphere_cell_close_above_a_plate_cell`). Much closer
 ///   still, the 32 cells stop resolving the layer: subdivide such pairs towards the contact, or
@@ -267,7 +267,7 @@ where
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
-    let p4 = (settings.order as u64).pow(4);
+    let p4 = (settings.order as u64).saturating_pow(4);
     #[cfg(feature = "closed-form")]
     if settings.boundaries && contour_applies(adjacency) {
         match flat_pair(a, b, settings.order, occluders) {

@@ -336,8 +336,8 @@ fn collapsed_among<T: Real>(lengths: [T; 4]) -> [bool; 4] {
 /// The nominal integrand evaluations of a touching transform at `order`: 6·order⁴ for a shared
 /// edge, 4·order⁴ for a shared vertex (times the ζ-shells of long or gapped pairs, not counted).
 pub(crate) fn touching_evaluations(adjacency: Adjacency, order: usize) -> u64 {
-    let per = if matches!(adjacency, Adjacency::SharedEdge { .. }) { 6 } else { 4 };
-    per * (order as u64).pow(4)
+    let per = if matches!(adjacency, Adjacency::SharedEdge { .. }) { 6u64 } else { 4 };
+    per.saturating_mul((order as u64).saturating_pow(4))
 }
 
 /// Length of the local coordinate line from `p` to `q` (a 4-segment polyline).

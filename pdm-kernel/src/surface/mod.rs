@@ -115,7 +115,7 @@ pub trait Surface<T: Real> {
     /// `Some((origin, edge_t, edge_s))` if the map is affine, g(t, s) = origin + t·edge_t +
     /// s·edge_s, with the constant normal ±edge_t × edge_s (a parallelogram). Visibility
     /// boundaries on such a patch are roots of low-degree polynomials, which
-    /// `boundary.rs` solves in closed form instead of bisecting. Default: `None`.
+    /// `boundary/` solves in closed form instead of bisecting. Default: `None`.
     #[cfg(feature = "closed-form")]
     #[inline]
     fn affine_map(&self) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {

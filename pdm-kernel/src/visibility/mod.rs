@@ -80,7 +80,7 @@ pub trait Occluder<T: Real> {
     /// `[a, b, c]` (a τ² + b τ + c) such that `blocks(p, origin + τ·direction)` can change value
     /// only at their real roots (extra polynomials are harmless, a missing one is a bug), and
     /// returns `true`; or returns `false`, and the caller brackets and bisects instead (the
-    /// default). Contract used by `boundary.rs`: for fixed `p` and `direction` and
+    /// default). Contract used by `boundary/`: for fixed `p` and `direction` and
     /// origins on a line (origin = o + s·v), every call passes the same number of polynomials
     /// in the same order, each coefficient a polynomial of degree ≤ 2 in s (true of anything
     /// built from dot products of origin − p taken at most twice).

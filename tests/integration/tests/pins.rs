@@ -257,6 +257,30 @@ fn surface_exchange_is_the_sum_of_its_pairs() {
     assert_eq!((by_tol.value, by_tol.evaluations, by_tol.error), (adaptive, adaptive_evals, Some(adaptive_error)));
     let total_met = adaptive_error <= 1e-5 * adaptive;
     assert_eq!(by_tol.converged, every_pair_converged || total_met);
+    // The paper's bare sum: `exchange` on each pair's samples, added in the same order.
+    let (mut paper, mut first) = (0.0, true);
+    for pa in a.clone() {
+        let sa = pdm_kernel::PatchSamples::<f64, 64>::new(&pa, 6).unwrap();
+        for pb in b.clone() {
+            let sb = pdm_kernel::PatchSamples::<f64, 64>::new(&pb, 6).unwrap();
+            let x = pdm_kernel::exchange(&sa, &sb, &screen).unwrap();
+            paper = if first { x } else { paper + x };
+            first = false;
+        }
+    }
+    let by_paper =
+        surface_exchange::<f64, _, _, _, 64>(a.clone(), b.clone(), Method::Paper(Quadrature::uniform(6)), &screen)
+            .unwrap();
+    assert_eq!((by_paper.value, by_paper.error, by_paper.converged), (paper, None, false));
+    // A grid iterated to its end has no pair left: zero, no estimate, not converged.
+    let mut spent = a.clone();
+    spent.by_ref().for_each(drop);
+    let empty = surface_exchange::<f64, _, _, _, 256>(spent, b.clone(), Method::Tolerance(tol), &()).unwrap();
+    assert_eq!((empty.value, empty.error, empty.converged, empty.evaluations), (0.0, None, false, 0));
+    // Settings are checked before the capacity.
+    let bad = Adaptive { max_order: 40, ..tol };
+    let refused = surface_exchange::<f64, _, _, _, 256>(a.clone(), b.clone(), Method::Tolerance(bad), &());
+    assert!(matches!(refused, Err(pdm_kernel::PdmError::InvalidSetting { name: "max_order", .. })), "{refused:?}");
     // Too small a capacity is refused before any work.
     let small = surface_exchange::<f64, _, _, _, 64>(a, b, Method::Tolerance(tol), &screen);
     assert_eq!(small, Err(pdm_kernel::PdmError::CapacityExceeded { needed: 144, capacity: 64 }));
