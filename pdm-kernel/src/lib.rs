@@ -101,7 +101,7 @@ pub use pair::{pair_exchange, PairSettings};
 pub use patch::{Patch, PatchGrid};
 pub use real::Real;
 pub use samples::{Ball, PatchSamples, Sample};
-pub use substructure::{surface_exchange, with_capacity, Method, WithCapacity, CAPACITIES};
+pub use substructure::{capacity_for, surface_exchange, with_capacity, Method, WithCapacity, CAPACITIES};
 pub use surface::{
     AutoNormal, BezierPatch, Cone, Cylinder, Disk, Flipped, Frame, Parallelogram, ParamRect, ParametricMap, Side,
     Sphere, Surface,

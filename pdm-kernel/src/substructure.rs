@@ -262,13 +262,21 @@ pub const CAPACITIES: [usize; 6] = [25, 64, 144, 256, 576, MAX_ORDER * MAX_ORDER
 /// ```
 pub fn with_capacity<J: WithCapacity>(needed: usize, job: J) -> Result<J::Output, PdmError> {
     const LARGEST: usize = MAX_ORDER * MAX_ORDER;
-    Ok(match needed {
-        0..=25 => job.run::<25>(),
-        26..=64 => job.run::<64>(),
-        65..=144 => job.run::<144>(),
-        145..=256 => job.run::<256>(),
-        257..=576 => job.run::<576>(),
-        577..=LARGEST => job.run::<LARGEST>(),
+    // One arm per entry of CAPACITIES (a const generic needs a literal).
+    Ok(match capacity_for(needed) {
+        Some(25) => job.run::<25>(),
+        Some(64) => job.run::<64>(),
+        Some(144) => job.run::<144>(),
+        Some(256) => job.run::<256>(),
+        Some(576) => job.run::<576>(),
+        Some(LARGEST) => job.run::<LARGEST>(),
         _ => return Err(PdmError::CapacityExceeded { needed, capacity: LARGEST }),
     })
+}
+
+/// The smallest of [`CAPACITIES`] that holds `needed` samples, `None` above the largest: the
+/// capacity [`with_capacity`] runs a job with.
+#[must_use]
+pub fn capacity_for(needed: usize) -> Option<usize> {
+    CAPACITIES.into_iter().find(|&c| c >= needed)
 }

@@ -61,11 +61,11 @@ pub fn thread_stack<T: Real>(cap: usize) -> usize {
     bytes.div_ceil(1 << 20) << 20
 }
 
-/// The capacity the host picks for `order` (smallest of [`CAPACITIES`] ≥ order², else the last).
+/// The capacity the host picks for `order` (the kernel's [`pdm_kernel::capacity_for`] order²,
+/// else the largest of [`CAPACITIES`]).
 #[must_use]
 pub fn capacity_for(order: usize) -> usize {
-    let need = order.saturating_mul(order);
-    CAPACITIES.into_iter().find(|&c| c >= need).unwrap_or(MAX_ORDER * MAX_ORDER)
+    pdm_kernel::capacity_for(order.saturating_mul(order)).unwrap_or(MAX_ORDER * MAX_ORDER)
 }
 
 /// A rayon pool of `threads` workers (0: as many as the current pool has) whose stacks hold
