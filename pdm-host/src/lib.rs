@@ -4,5 +4,6 @@
 pub mod csv_num;
 pub mod gauss_gen;
 pub mod reference;
+pub mod scene;
 pub mod tradeoff;
 pub mod validate;

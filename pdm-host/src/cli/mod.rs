@@ -1,5 +1,6 @@
 //! Command-line parsing and the `validate` command's driver.
 
+mod matrix;
 mod progress;
 
 use std::io::Write as _;
@@ -32,6 +33,9 @@ enum Command {
     Validate(ValidateArgs),
     /// Accuracy against cost sweeps (CSV, SVG, Pareto fronts); curved patches vs polygons.
     Tradeoff(pdm_host::tradeoff::TradeoffArgs),
+    /// Form factors of your own scene (a TOML or JSON file): patch and surface matrices with
+    /// error estimates, row sums and diagnostics.
+    Matrix(matrix::MatrixArgs),
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -175,6 +179,7 @@ pub fn main() -> ExitCode {
     };
     match cli.command {
         Command::Validate(args) => run_validate(&args),
+        Command::Matrix(args) => matrix::run(&args),
         Command::Tradeoff(args) => match pdm_host::tradeoff::run(&args) {
             Ok(()) => ExitCode::SUCCESS,
             Err(e) => {

@@ -20,12 +20,16 @@ pub struct Bar {
 }
 
 impl Bar {
-    /// A bar over `total` units.
+    /// A bar over `total` patches.
     pub fn new(total: u64) -> Self {
+        Self::with_units(total, "patches")
+    }
+
+    /// A bar over `total` units named `units`.
+    pub fn with_units(total: u64, units: &str) -> Self {
         let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::hidden());
-        if let Ok(style) =
-            ProgressStyle::with_template("{msg:<15} [{bar:30}] {pos}/{len} patches, {elapsed} (eta {eta})")
-        {
+        let template = format!("{{msg:<15}} [{{bar:30}}] {{pos}}/{{len}} {units}, {{elapsed}} (eta {{eta}})");
+        if let Ok(style) = ProgressStyle::with_template(&template) {
             bar.set_style(style.progress_chars("=> "));
         }
         Self { bar, start: Instant::now(), terminal: std::io::stderr().is_terminal(), shown: AtomicBool::new(false) }
@@ -35,6 +39,12 @@ impl Bar {
         if self.terminal && self.start.elapsed() > SHOW_AFTER && !self.shown.swap(true, Ordering::Relaxed) {
             self.bar.set_draw_target(ProgressDrawTarget::stderr_with_hz(8));
         }
+    }
+
+    /// Sets the units done.
+    pub fn set_position(&self, done: u64) {
+        self.bar.set_position(done);
+        self.maybe_show();
     }
 
     /// Removes the bar from the terminal.

@@ -1,0 +1,456 @@
+//! From the file's model to the scene's geometry: placement, sides, pieces and patches, every
+//! value checked with an error that names the surface and the field.
+
+use pdm_kernel::{vec3, Frame, ParamRect, Vec3};
+
+use super::model::{fields_of, Kind, SceneFile, SideSpec, SurfaceSpec};
+use super::shape::{Geom, Rect};
+
+/// Most patches a scene may have (the matrix has patches² entries).
+pub const MAX_PATCHES: usize = 20_000;
+/// Most patches along one side of one piece.
+pub const MAX_SUBDIVISION: usize = 1_000;
+
+/// A surface of the scene: one radiating side of one named entry of the file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneSurface {
+    /// The name (`NAME/front`, `NAME/back`, `NAME/outer`, `NAME/inner` for the two sides of one
+    /// entry).
+    pub name: String,
+    /// The kind.
+    pub kind: Kind,
+    /// Index of the file's entry: the two sides of one entry share it (one geometry, one
+    /// occluder).
+    pub entry: usize,
+    /// Whether it blocks the view between other surfaces.
+    pub occludes: bool,
+    /// Its pieces: one kernel surface each (several for a Bézier net), with the parameter range
+    /// used and the subdivision.
+    pub pieces: Vec<Piece>,
+}
+
+/// One kernel surface of a scene surface.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Piece {
+    /// The geometry.
+    pub geom: Geom,
+    /// The part of its parameter domain that belongs to the scene.
+    pub rect: Rect,
+    /// Patches along t and s.
+    pub grid: (usize, usize),
+}
+
+/// A patch of the scene.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ScenePatch {
+    /// Index into [`Scene::surfaces`].
+    pub surface: usize,
+    /// Index into that surface's pieces.
+    pub piece: usize,
+    /// Its cell (i, j) of the piece's grid.
+    pub cell: (usize, usize),
+    /// Its parameter rectangle.
+    pub rect: Rect,
+}
+
+/// A scene ready to compute.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scene {
+    /// The length unit.
+    pub units: String,
+    /// Whether the surfaces close an enclosure.
+    pub enclosure: bool,
+    /// The surfaces (a two-sided entry gives two).
+    pub surfaces: Vec<SceneSurface>,
+    /// All patches, surface by surface, piece by piece, row by row.
+    pub patches: Vec<ScenePatch>,
+}
+
+impl Scene {
+    /// The geometry of a patch.
+    #[must_use]
+    pub fn geom(&self, p: &ScenePatch) -> &Geom {
+        &self.surfaces[p.surface].pieces[p.piece].geom
+    }
+}
+
+/// A semantic error in one surface entry: which entry, which field, what is wrong.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct EntryError {
+    /// Index of the entry in the file.
+    pub entry: usize,
+    /// Its name, if it has one.
+    pub name: String,
+    /// The field at fault (empty for the entry as a whole).
+    pub field: String,
+    /// What is wrong.
+    pub message: String,
+}
+
+fn fail<T>(i: usize, spec: &SurfaceSpec, field: &str, message: impl Into<String>) -> Result<T, EntryError> {
+    Err(EntryError { entry: i, name: spec.name.clone(), field: field.to_string(), message: message.into() })
+}
+
+fn finite3(v: [f64; 3]) -> bool {
+    v.iter().all(|x| x.is_finite())
+}
+
+fn v3(v: [f64; 3]) -> Vec3<f64> {
+    vec3(v[0], v[1], v[2])
+}
+
+/// Rodrigues' rotation about a unit axis k by angle a.
+fn rotate(v: Vec3<f64>, k: Vec3<f64>, a: f64) -> Vec3<f64> {
+    let (s, c) = a.sin_cos();
+    v.scale(c) + k.cross(v).scale(s) + k.scale(k.dot(v) * (1.0 - c))
+}
+
+/// Placement: rotation about the origin, then translation.
+struct Place {
+    axis: Vec3<f64>,
+    angle: f64,
+    shift: Vec3<f64>,
+}
+
+impl Place {
+    fn vector(&self, v: Vec3<f64>) -> Vec3<f64> {
+        if self.angle == 0.0 {
+            v
+        } else {
+            rotate(v, self.axis, self.angle)
+        }
+    }
+    fn point(&self, p: Vec3<f64>) -> Vec3<f64> {
+        self.vector(p) + self.shift
+    }
+}
+
+/// Reads a required vector field.
+fn vector(i: usize, spec: &SurfaceSpec, name: &str, value: Option<[f64; 3]>) -> Result<Vec3<f64>, EntryError> {
+    match value {
+        None => fail(i, spec, name, format!("missing (kind {} needs it)", spec.kind.name())),
+        Some(v) if !finite3(v) => fail(i, spec, name, format!("{v:?} is not finite")),
+        Some(v) => Ok(v3(v)),
+    }
+}
+
+/// Reads a required positive length.
+fn positive(i: usize, spec: &SurfaceSpec, name: &str, value: Option<f64>) -> Result<f64, EntryError> {
+    match value {
+        None => fail(i, spec, name, format!("missing (kind {} needs it)", spec.kind.name())),
+        Some(x) if !(x.is_finite() && x > 0.0) => fail(i, spec, name, format!("{x} must be positive and finite")),
+        Some(x) => Ok(x),
+    }
+}
+
+/// A non-zero direction.
+fn direction(i: usize, spec: &SurfaceSpec, name: &str, v: Vec3<f64>) -> Result<Frame<f64>, EntryError> {
+    match Frame::from_axis(v) {
+        Ok(f) => Frame::from_axis(f.axis).or_else(|_| fail(i, spec, name, "is a zero vector")),
+        Err(_) => fail(i, spec, name, format!("[{}, {}, {}] is a zero vector", v.x, v.y, v.z)),
+    }
+}
+
+/// An angle range in degrees within [0, limit], as radians.
+fn angles(
+    i: usize,
+    spec: &SurfaceSpec,
+    name: &str,
+    value: Option<[f64; 2]>,
+    limit: f64,
+) -> Result<(f64, f64), EntryError> {
+    let [a, b] = value.unwrap_or([0.0, limit]);
+    if !(a.is_finite() && b.is_finite() && a >= 0.0 && b <= limit && a < b) {
+        return fail(i, spec, name, format!("[{a}, {b}] must satisfy 0 <= from < to <= {limit} (degrees)"));
+    }
+    // The whole range exactly (the kernel recognises closed surfaces by their domain).
+    let radians = |x: f64| {
+        if x == 180.0 {
+            core::f64::consts::PI
+        } else if x == 360.0 {
+            2.0 * core::f64::consts::PI
+        } else {
+            x.to_radians()
+        }
+    };
+    Ok((radians(a), radians(b)))
+}
+
+/// The frame with the placement applied to all three vectors (θ = 0 along the rotated u).
+fn placed_frame(frame: Frame<f64>, place: &Place) -> Frame<f64> {
+    Frame { u: place.vector(frame.u), w: place.vector(frame.w), axis: place.vector(frame.axis) }
+}
+
+/// The geometry of one side of an entry: `back` (sheets) or `inner` (closed kinds) flips it.
+fn geometry(i: usize, spec: &SurfaceSpec, flip: bool, place: &Place) -> Result<Vec<(Geom, Rect)>, EntryError> {
+    let (required, optional) = fields_of(spec.kind);
+    for field in spec.geometry_fields() {
+        if !required.contains(&field) && !optional.contains(&field) {
+            return fail(i, spec, field, format!("does not belong to kind {}", spec.kind.name()));
+        }
+    }
+    let full = |g: Geom| Ok(vec![(g, g.domain())]);
+    match spec.kind {
+        Kind::Rectangle => {
+            let origin = place.point(vector(i, spec, "origin", spec.origin)?);
+            let edge_t = place.vector(vector(i, spec, "edge_t", spec.edge_t)?);
+            let edge_s = place.vector(vector(i, spec, "edge_s", spec.edge_s)?);
+            let area = edge_t.cross(edge_s).norm();
+            if !(area > 1e-12 * edge_t.norm() * edge_s.norm()) {
+                return fail(i, spec, "edge_s", "is parallel to edge_t (or one of them is zero): zero area");
+            }
+            let (edge_t, edge_s) = if flip { (edge_s, edge_t) } else { (edge_t, edge_s) };
+            full(Geom::Parallelogram { origin, edge_t, edge_s })
+        }
+        Kind::Disk => {
+            let center = place.point(vector(i, spec, "center", spec.center)?);
+            let normal = vector(i, spec, "normal", spec.normal)?;
+            let outer = positive(i, spec, "radius", spec.radius)?;
+            let inner = spec.inner_radius.unwrap_or(0.0);
+            if !(inner.is_finite() && inner >= 0.0 && inner < outer) {
+                return fail(i, spec, "inner_radius", format!("{inner} must satisfy 0 <= inner_radius < radius"));
+            }
+            let axis = place.vector(normal);
+            let frame = direction(i, spec, "normal", if flip { -axis } else { axis })?;
+            let (a, b) = angles(i, spec, "theta", spec.theta, 360.0)?;
+            let g = Geom::Disk { center, frame, inner, outer };
+            Ok(vec![(g, ParamRect { t0: inner, t1: outer, s0: a, s1: b })])
+        }
+        Kind::Sphere => {
+            let center = place.point(vector(i, spec, "center", spec.center)?);
+            let radius = positive(i, spec, "radius", spec.radius)?;
+            let axis = match spec.axis {
+                Some(v) if !finite3(v) => return fail(i, spec, "axis", format!("{v:?} is not finite")),
+                Some(v) => v3(v),
+                None => vec3(0.0, 0.0, 1.0),
+            };
+            let frame = placed_frame(direction(i, spec, "axis", axis)?, place);
+            let (p0, p1) = angles(i, spec, "phi", spec.phi, 180.0)?;
+            let (a, b) = angles(i, spec, "theta", spec.theta, 360.0)?;
+            let g = Geom::Sphere { center, radius, frame, inner: flip };
+            Ok(vec![(g, ParamRect { t0: p0, t1: p1, s0: a, s1: b })])
+        }
+        Kind::Cylinder | Kind::Cone => {
+            let base = place.point(vector(i, spec, "base", spec.base)?);
+            let axis = place.vector(vector(i, spec, "axis", spec.axis)?);
+            let frame = direction(i, spec, "axis", axis)?;
+            let height = positive(i, spec, "height", spec.height)?;
+            let (a, b) = angles(i, spec, "theta", spec.theta, 360.0)?;
+            let g = if spec.kind == Kind::Cylinder {
+                let radius = positive(i, spec, "radius", spec.radius)?;
+                Geom::Cylinder { base, frame, radius, height, inner: flip }
+            } else {
+                let r = |name: &str, v: Option<f64>| match v {
+                    None => fail(i, spec, name, "missing (kind cone needs it)"),
+                    Some(x) if !(x.is_finite() && x >= 0.0) => {
+                        fail(i, spec, name, format!("{x} must be non-negative and finite"))
+                    }
+                    Some(x) => Ok(x),
+                };
+                let (base_radius, top_radius) =
+                    (r("base_radius", spec.base_radius)?, r("top_radius", spec.top_radius)?);
+                if base_radius + top_radius <= 0.0 {
+                    return fail(i, spec, "top_radius", "base_radius and top_radius are both zero");
+                }
+                Geom::Cone { base, frame, base_radius, top_radius, height, inner: flip }
+            };
+            Ok(vec![(g, ParamRect { t0: a, t1: b, s0: 0.0, s1: height })])
+        }
+        Kind::Bezier => {
+            let Some(net) = &spec.control else { return fail(i, spec, "control", "missing (kind bezier needs it)") };
+            let rows = net.len();
+            let cols = net.first().map_or(0, Vec::len);
+            if rows < 4 || (rows - 1) % 3 != 0 || cols < 4 || (cols - 1) % 3 != 0 || net.iter().any(|r| r.len() != cols)
+            {
+                return fail(
+                    i,
+                    spec,
+                    "control",
+                    format!("must be (3m + 1) rows of (3n + 1) points each (m, n >= 1), got {rows} rows of {cols}"),
+                );
+            }
+            if let Some((r, c)) =
+                net.iter().enumerate().find_map(|(r, row)| row.iter().position(|p| !finite3(*p)).map(|c| (r, c)))
+            {
+                return fail(i, spec, "control", format!("point [{r}][{c}] is not finite"));
+            }
+            let mut out = Vec::new();
+            for pi in 0..(rows - 1) / 3 {
+                for pj in 0..(cols - 1) / 3 {
+                    let mut control = [[vec3(0.0, 0.0, 0.0); 4]; 4];
+                    for (a, row) in control.iter_mut().enumerate() {
+                        for (b, p) in row.iter_mut().enumerate() {
+                            // Flipped: transposed (t and s swap, the normal turns over).
+                            let (r, c) = if flip { (3 * pi + b, 3 * pj + a) } else { (3 * pi + a, 3 * pj + b) };
+                            *p = place.point(v3(net[r][c]));
+                        }
+                    }
+                    let g = Geom::Bezier { control };
+                    out.push((g, g.domain()));
+                }
+            }
+            Ok(out)
+        }
+    }
+}
+
+/// Arc length of the parameter line through the middle of `rect` along t (`along_t`) or s.
+fn mid_length(geom: &Geom, rect: Rect, along_t: bool) -> f64 {
+    let Ok(shape) = geom.shape::<f64>() else { return 0.0 };
+    use pdm_kernel::Surface as _;
+    const SEGMENTS: usize = 64;
+    let (tm, sm) = ((rect.t0 + rect.t1) / 2.0, (rect.s0 + rect.s1) / 2.0);
+    let at = |x: f64| {
+        if along_t {
+            shape.point(rect.t0 + (rect.t1 - rect.t0) * x, sm)
+        } else {
+            shape.point(tm, rect.s0 + (rect.s1 - rect.s0) * x)
+        }
+    };
+    (0..SEGMENTS).map(|k| (at((k + 1) as f64 / SEGMENTS as f64) - at(k as f64 / SEGMENTS as f64)).norm()).sum()
+}
+
+/// Builds the scene: checks every entry, places it, splits two-sided entries, subdivides.
+pub fn build(file: &SceneFile) -> Result<Scene, EntryError> {
+    if file.surfaces.is_empty() {
+        return Err(EntryError {
+            entry: 0,
+            name: String::new(),
+            field: "surface".into(),
+            message: "the scene has no surfaces".into(),
+        });
+    }
+    let mut surfaces = Vec::new();
+    for (i, spec) in file.surfaces.iter().enumerate() {
+        if spec.name.trim().is_empty() {
+            return fail(i, spec, "name", "is empty");
+        }
+        if let Some(j) = file.surfaces[..i].iter().position(|s| s.name == spec.name) {
+            return fail(i, spec, "name", format!("is already used by surface #{}", j + 1));
+        }
+        let place = match (spec.rotate, spec.translate) {
+            (Some(r), _) if !(finite3(r.axis) && r.degrees.is_finite()) => {
+                return fail(i, spec, "rotate", "axis and degrees must be finite")
+            }
+            (Some(r), _) if v3(r.axis).norm() == 0.0 => return fail(i, spec, "rotate.axis", "is a zero vector"),
+            (_, Some(t)) if !finite3(t) => return fail(i, spec, "translate", format!("{t:?} is not finite")),
+            (r, t) => Place {
+                axis: r.map_or(vec3(0.0, 0.0, 1.0), |r| v3(r.axis).scale(1.0 / v3(r.axis).norm())),
+                angle: r.map_or(0.0, |r| r.degrees.to_radians()),
+                shift: t.map_or(vec3(0.0, 0.0, 0.0), v3),
+            },
+        };
+        let closed = spec.kind.closed();
+        let sides: Vec<(bool, &str)> = match (spec.side, closed) {
+            (None | Some(SideSpec::Front), false) => vec![(false, "")],
+            (Some(SideSpec::Back), false) => vec![(true, "")],
+            (None | Some(SideSpec::Outer), true) => vec![(false, "")],
+            (Some(SideSpec::Inner), true) => vec![(true, "")],
+            (Some(SideSpec::Both), false) => vec![(false, "/front"), (true, "/back")],
+            (Some(SideSpec::Both), true) => vec![(false, "/outer"), (true, "/inner")],
+            (Some(other), _) => {
+                let allowed = if closed { "outer, inner or both" } else { "front, back or both" };
+                return fail(
+                    i,
+                    spec,
+                    "side",
+                    format!("{other:?} is not a side of kind {} ({allowed})", spec.kind.name()),
+                );
+            }
+        };
+        if spec.subdivide.is_some() && spec.patch_size.is_some() {
+            return fail(i, spec, "patch_size", "give either subdivide or patch_size, not both");
+        }
+        if let Some([m, n]) = spec.subdivide {
+            if !(1..=MAX_SUBDIVISION).contains(&m) || !(1..=MAX_SUBDIVISION).contains(&n) {
+                return fail(i, spec, "subdivide", format!("[{m}, {n}] must lie in 1..={MAX_SUBDIVISION}"));
+            }
+        }
+        if let Some(size) = spec.patch_size {
+            if !(size.is_finite() && size > 0.0) {
+                return fail(i, spec, "patch_size", format!("{size} must be positive and finite"));
+            }
+        }
+        for (flip, suffix) in sides {
+            let mut pieces = Vec::new();
+            for (geom, rect) in geometry(i, spec, flip, &place)? {
+                let grid = match (spec.subdivide, spec.patch_size) {
+                    (Some([m, n]), _) => (m, n),
+                    (None, Some(size)) => {
+                        let count = |along_t| (mid_length(&geom, rect, along_t) / size).ceil().max(1.0);
+                        let (m, n) = (count(true), count(false));
+                        if m > MAX_SUBDIVISION as f64 || n > MAX_SUBDIVISION as f64 {
+                            return fail(
+                                i,
+                                spec,
+                                "patch_size",
+                                format!("{size} gives {m} x {n} patches per piece, more than {MAX_SUBDIVISION} a side"),
+                            );
+                        }
+                        (m as usize, n as usize)
+                    }
+                    (None, None) => (1, 1),
+                };
+                // The kernel's own checks (a zero-area Bézier net is found when sampled).
+                if let Err(e) = geom.shape::<f64>() {
+                    return fail(i, spec, "", format!("the kernel rejects the geometry: {e}"));
+                }
+                pieces.push(Piece { geom, rect, grid });
+            }
+            let occludes = spec.occludes.unwrap_or(true);
+            if occludes {
+                let whole = pieces.len() == 1 && pieces.iter().all(|p| p.rect == p.geom.domain());
+                let kind_has = matches!(spec.kind, Kind::Rectangle | Kind::Disk | Kind::Sphere | Kind::Cylinder);
+                if !kind_has || !whole {
+                    let what = if kind_has {
+                        format!("a part of a {} (a `theta` or `phi` range)", spec.kind.name())
+                    } else {
+                        format!("a {} surface", spec.kind.name())
+                    };
+                    return fail(
+                        i,
+                        spec,
+                        "occludes",
+                        format!(
+                            "is true (the default), but pdm has no occluder for {what}; set `occludes = false` \
+                             (exact only if it hides nothing between other surfaces)"
+                        ),
+                    );
+                }
+            }
+            surfaces.push(SceneSurface {
+                name: format!("{}{suffix}", spec.name),
+                kind: spec.kind,
+                entry: i,
+                occludes,
+                pieces,
+            });
+        }
+    }
+    let mut patches = Vec::new();
+    for (si, s) in surfaces.iter().enumerate() {
+        for (pi, piece) in s.pieces.iter().enumerate() {
+            let (m, n) = piece.grid;
+            for a in 0..m {
+                for b in 0..n {
+                    patches.push(ScenePatch {
+                        surface: si,
+                        piece: pi,
+                        cell: (a, b),
+                        rect: piece.rect.cell(a, b, m, n),
+                    });
+                }
+            }
+            if patches.len() > MAX_PATCHES {
+                let spec = &file.surfaces[s.entry];
+                return fail(
+                    s.entry,
+                    spec,
+                    "subdivide",
+                    format!("the scene would have more than {MAX_PATCHES} patches"),
+                );
+            }
+        }
+    }
+    Ok(Scene { units: file.units.clone(), enclosure: file.enclosure, surfaces, patches })
+}

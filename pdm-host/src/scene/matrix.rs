@@ -1,0 +1,385 @@
+//! The form-factor matrices of a scene: every unordered patch pair computed once by the
+//! kernel (the other direction by reciprocity, A_i·F_ij = A_j·F_ji), each against only the
+//! occluders that can cut it, pairs that cannot see each other skipped, rayon over pairs.
+
+use std::time::Instant;
+
+use pdm_kernel::{
+    adaptive_exchange, pair_exchange, Adaptive, AnyOccluder, Ball, Occluder as _, PairSettings, Patch, PdmError, Real,
+    Vec3, WithCapacity,
+};
+use rayon::prelude::*;
+
+use super::build::{Scene, ScenePatch};
+use super::shape::{occluder_of, Geom, Plane, Shape};
+use crate::validate::stack;
+
+/// How each pair is integrated.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PairMethod {
+    /// The tolerance mode (`adaptive_exchange`): per-pair relative tolerance, with an error
+    /// estimate for every entry.
+    Tolerance(f64),
+    /// Fixed orders (`pair_exchange`): Gauss order for separate pairs, order of the touching
+    /// transforms; no error estimate.
+    Order {
+        /// Gauss points per axis (separate pairs).
+        order: usize,
+        /// Gauss points per variable (touching pairs).
+        singular_order: usize,
+    },
+}
+
+/// Largest order of the tolerance mode here (as in `pdm-ff validate`).
+pub const ADAPTIVE_MAX_ORDER: usize = 12;
+
+impl PairMethod {
+    /// The sample capacity the method needs (order², the kernel's `CAPACITIES`).
+    #[must_use]
+    pub fn capacity(&self) -> usize {
+        match *self {
+            Self::Tolerance(_) => stack::capacity_for(ADAPTIVE_MAX_ORDER),
+            Self::Order { order, .. } => stack::capacity_for(order),
+        }
+    }
+}
+
+/// One computed unordered pair (i ≤ j): E = A_i·F_ij = A_j·F_ji.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PairValue {
+    /// First patch.
+    pub i: usize,
+    /// Second patch.
+    pub j: usize,
+    /// A_i·F_ij.
+    pub exchange: f64,
+    /// Estimated absolute error of `exchange` (tolerance mode).
+    pub error: Option<f64>,
+    /// Whether the estimate met the tolerance.
+    pub converged: bool,
+    /// Kernel evaluations.
+    pub evaluations: u64,
+    /// Wall time of the kernel call (s).
+    pub seconds: f64,
+    /// Occluders the pair was tested against.
+    pub occluders: usize,
+}
+
+/// The result of [`compute`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct MatrixResult {
+    /// Patch areas (the kernel's Gauss area at order 16).
+    pub areas: Vec<f64>,
+    /// Every pair that was integrated (skipped pairs are zero by geometry).
+    pub pairs: Vec<PairValue>,
+    /// Unordered pairs skipped without a kernel call (back to back, or on one convex surface).
+    pub skipped: usize,
+    /// Wall time of the whole computation (s).
+    pub seconds: f64,
+}
+
+/// A failure of one pair, with the patches named (`i == j` for a patch on its own).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PairError {
+    /// First patch.
+    pub i: usize,
+    /// Second patch.
+    pub j: usize,
+    /// The kernel's error.
+    pub error: PdmError,
+}
+
+/// Why [`compute`] failed.
+#[derive(Clone, Debug, PartialEq)]
+pub enum MatrixError {
+    /// A pair (or a patch) the kernel refused.
+    Pair(PairError),
+    /// The worker threads could not be started.
+    Threads(String),
+}
+
+impl From<PairError> for MatrixError {
+    fn from(e: PairError) -> Self {
+        Self::Pair(e)
+    }
+}
+
+fn ball_f64<T: Real>(b: &Ball<T>) -> (Vec3<f64>, f64) {
+    (pdm_kernel::vec3(b.center.x.to_f64(), b.center.y.to_f64(), b.center.z.to_f64()), b.radius.to_f64())
+}
+
+/// Per-patch data the pair loop needs.
+struct PatchInfo<T> {
+    ball: Ball<T>,
+    area: T,
+}
+
+/// Whether the patch `p` lies within the closed solid bounded by the concave surface `solid`
+/// (a segment between it and a point of that surface then stays inside the solid, which its
+/// surface cannot cut). Conservative: `false` when unsure.
+fn inside_solid(solid: &Geom, geom: &Geom, p: &ScenePatch, ball: (Vec3<f64>, f64), tol: f64) -> bool {
+    let (bc, br) = ball;
+    match *solid {
+        Geom::Sphere { center, radius, .. } => {
+            let reach = match *geom {
+                Geom::Parallelogram { origin, edge_t, edge_s } => {
+                    let r = p.rect;
+                    [(r.t0, r.s0), (r.t1, r.s0), (r.t0, r.s1), (r.t1, r.s1)]
+                        .iter()
+                        .map(|&(t, s)| (origin + edge_t.scale(t) + edge_s.scale(s) - center).norm())
+                        .fold(0.0, f64::max)
+                }
+                Geom::Disk { center: c, outer, .. } => (c - center).norm() + outer,
+                _ => (bc - center).norm() + br,
+            };
+            reach <= radius + tol
+        }
+        Geom::Cylinder { base, frame, radius, height, .. } => {
+            let axial = Plane { origin: base, normal: frame.axis };
+            let (lo, hi) = geom.distance_range(p.rect, &axial);
+            if !(lo >= -tol && hi <= height + tol) {
+                return false;
+            }
+            let radial = |x: Vec3<f64>| {
+                let d = x - base;
+                (d - frame.axis.scale(d.dot(frame.axis))).norm()
+            };
+            let reach = match *geom {
+                Geom::Parallelogram { origin, edge_t, edge_s } => {
+                    let r = p.rect;
+                    [(r.t0, r.s0), (r.t1, r.s0), (r.t0, r.s1), (r.t1, r.s1)]
+                        .iter()
+                        .map(|&(t, s)| radial(origin + edge_t.scale(t) + edge_s.scale(s)))
+                        .fold(0.0, f64::max)
+                }
+                Geom::Disk { center, outer, .. } => radial(center) + outer,
+                _ => radial(bc) + br,
+            };
+            reach <= radius + tol
+        }
+        _ => false,
+    }
+}
+
+/// Everything the pair loop reads, shared by the workers.
+struct Context<'s, T> {
+    scene: &'s Scene,
+    shapes: Vec<Vec<Shape<T>>>,
+    occluders: Vec<Option<AnyOccluder<T>>>,
+    info: Vec<PatchInfo<T>>,
+    balls: Vec<(Vec3<f64>, f64)>,
+    planes: Vec<Option<Plane>>,
+    tol: f64,
+}
+
+/// What to do with one unordered pair.
+enum Plan<T> {
+    /// Zero by geometry.
+    Skip,
+    /// Integrate against these occluders.
+    Integrate(Vec<AnyOccluder<T>>),
+}
+
+impl<T: Real> Context<'_, T> {
+    fn patch(&self, i: usize) -> Result<Patch<'_, T, Shape<T>>, PdmError> {
+        let p = &self.scene.patches[i];
+        let r = p.rect;
+        let rect = pdm_kernel::ParamRect {
+            t0: T::from_f64(r.t0),
+            t1: T::from_f64(r.t1),
+            s0: T::from_f64(r.s0),
+            s1: T::from_f64(r.s1),
+        };
+        Patch::new(&self.shapes[p.surface][p.piece], rect)
+    }
+
+    /// `true` if patch `j` lies wholly behind or in the plane of the flat patch `i`.
+    fn behind(&self, i: usize, j: usize) -> bool {
+        match &self.planes[i] {
+            Some(plane) => {
+                let pj = &self.scene.patches[j];
+                self.scene.geom(pj).distance_range(pj.rect, plane).1 <= self.tol
+            }
+            None => false,
+        }
+    }
+
+    fn plan(&self, i: usize, j: usize) -> Plan<T> {
+        let scene = self.scene;
+        let (pi, pj) = (&scene.patches[i], &scene.patches[j]);
+        let (si, sj) = (&scene.surfaces[pi.surface], &scene.surfaces[pj.surface]);
+        let (gi, gj) = (scene.geom(pi), scene.geom(pj));
+        // Patches of one convex side of a sphere, tube or cone, or one flat sheet, never see
+        // each other (a chord of a convex solid leaves it only at its ends).
+        if si.entry == sj.entry && pi.surface == pj.surface && !gi.concave() && !matches!(gi, Geom::Bezier { .. }) {
+            return Plan::Skip;
+        }
+        if self.behind(i, j) || self.behind(j, i) {
+            return Plan::Skip;
+        }
+        let (bi, bj) = (&self.info[i].ball, &self.info[j].ball);
+        let mut list = Vec::new();
+        for (k, s) in scene.surfaces.iter().enumerate() {
+            let Some(occluder) = self.occluders[k] else { continue };
+            // The two sides of one entry are one occluder: take it once.
+            if scene.surfaces[..k].iter().enumerate().any(|(m, o)| o.entry == s.entry && self.occluders[m].is_some()) {
+                continue;
+            }
+            let geom = &s.pieces[0].geom;
+            if s.entry == si.entry || s.entry == sj.entry {
+                // A segment between two points of one surface is a chord of its solid; a flat
+                // sheet or a convex side never blocks a segment that starts on it and passes
+                // the facing test; a concave side blocks only segments that leave its solid.
+                if si.entry == sj.entry {
+                    continue;
+                }
+                let (on, other) = if s.entry == si.entry { (pi, j) } else { (pj, i) };
+                let solid = scene.geom(on);
+                if !solid.concave() {
+                    continue;
+                }
+                let po = &scene.patches[other];
+                if inside_solid(solid, scene.geom(po), po, self.balls[other], self.tol) {
+                    continue;
+                }
+            }
+            if !occluder.may_block_between(bi, bj) {
+                continue;
+            }
+            if let Some(plane) = geom.plane() {
+                let (lo_i, hi_i) = gi.distance_range(pi.rect, &plane);
+                let (lo_j, hi_j) = gj.distance_range(pj.rect, &plane);
+                if (lo_i >= -self.tol && lo_j >= -self.tol) || (hi_i <= self.tol && hi_j <= self.tol) {
+                    continue;
+                }
+            }
+            list.push(occluder);
+        }
+        Plan::Integrate(list)
+    }
+
+    fn pair<const CAP: usize>(&self, i: usize, j: usize, method: PairMethod) -> Result<Option<PairValue>, PairError> {
+        let occluders = match self.plan(i, j) {
+            Plan::Skip => return Ok(None),
+            Plan::Integrate(list) => list,
+        };
+        let wrap = |error| PairError { i, j, error };
+        let (a, b) = (self.patch(i).map_err(wrap)?, self.patch(j).map_err(wrap)?);
+        let start = Instant::now();
+        let estimate = match method {
+            PairMethod::Tolerance(tolerance) => {
+                let settings = Adaptive {
+                    tolerance: T::from_f64(tolerance),
+                    max_order: ADAPTIVE_MAX_ORDER,
+                    max_depth: stack::ADAPTIVE_MAX_DEPTH,
+                };
+                adaptive_exchange::<T, _, _, [AnyOccluder<T>], CAP>(&a, &b, settings, occluders.as_slice())
+            }
+            PairMethod::Order { order, singular_order } => {
+                let settings = PairSettings { order, singular_order, boundaries: true };
+                pair_exchange::<T, _, _, [AnyOccluder<T>], CAP>(&a, &b, settings, occluders.as_slice())
+            }
+        }
+        .map_err(wrap)?;
+        Ok(Some(PairValue {
+            i,
+            j,
+            exchange: estimate.value.to_f64(),
+            error: estimate.error.map(Real::to_f64),
+            converged: estimate.converged,
+            evaluations: estimate.evaluations,
+            seconds: start.elapsed().as_secs_f64(),
+            occluders: occluders.len(),
+        }))
+    }
+}
+
+/// Computes every unordered pair of the scene in precision `T` with `threads` workers (0: all
+/// cores); `progress` is called with the number of pairs done so far.
+pub fn compute<T: Real>(
+    scene: &Scene,
+    method: PairMethod,
+    threads: usize,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<MatrixResult, MatrixError> {
+    struct Job<'a, T> {
+        scene: &'a Scene,
+        method: PairMethod,
+        threads: usize,
+        progress: &'a (dyn Fn(u64) + Sync),
+        precision: std::marker::PhantomData<T>,
+    }
+    impl<T: Real> WithCapacity for Job<'_, T> {
+        type Output = Result<MatrixResult, MatrixError>;
+        fn run<const CAP: usize>(self) -> Self::Output {
+            compute_with::<T, CAP>(self.scene, self.method, self.threads, self.progress)
+        }
+    }
+    let job = Job::<T> { scene, method, threads, progress, precision: std::marker::PhantomData };
+    pdm_kernel::with_capacity(method.capacity(), job).map_err(|error| MatrixError::Threads(error.to_string()))?
+}
+
+fn compute_with<T: Real, const CAP: usize>(
+    scene: &Scene,
+    method: PairMethod,
+    threads: usize,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<MatrixResult, MatrixError> {
+    let start = Instant::now();
+    let at = |i: usize| move |error| PairError { i, j: i, error };
+    let mut shapes = Vec::with_capacity(scene.surfaces.len());
+    let mut occluders = Vec::with_capacity(scene.surfaces.len());
+    for s in &scene.surfaces {
+        let first = scene.patches.iter().position(|p| scene.surfaces[p.surface].name == s.name).unwrap_or(0);
+        let list = s.pieces.iter().map(|p| p.geom.shape::<T>()).collect::<Result<Vec<_>, _>>().map_err(at(first))?;
+        // Whole-surface occluders exist for single-piece kinds only (the scene's builder
+        // refuses `occludes` where there is none).
+        occluders.push(if s.occludes && list.len() == 1 { list.first().and_then(occluder_of) } else { None });
+        shapes.push(list);
+    }
+    let mut ctx =
+        Context { scene, shapes, occluders, info: Vec::new(), balls: Vec::new(), planes: Vec::new(), tol: 0.0 };
+    let mut info = Vec::with_capacity(scene.patches.len());
+    for (i, p) in scene.patches.iter().enumerate() {
+        let patch = ctx.patch(i).map_err(at(i))?;
+        let area = patch.area(16).map_err(at(i))?;
+        info.push(PatchInfo { ball: patch.enclosing_ball(), area });
+        ctx.planes.push(scene.geom(p).plane());
+    }
+    ctx.balls = info.iter().map(|x| ball_f64(&x.ball)).collect();
+    let scale = ctx.balls.iter().map(|(c, r)| c.max_abs() + r).fold(0.0, f64::max);
+    ctx.tol = 1e-9 * scale;
+    ctx.info = info;
+
+    let n = scene.patches.len();
+    let pairs: Vec<(usize, usize)> = (0..n).flat_map(|i| (i..n).map(move |j| (i, j))).collect();
+    let done = std::sync::atomic::AtomicU64::new(0);
+    let pool = stack::pool::<T>(threads, CAP).map_err(MatrixError::Threads)?;
+    let results: Vec<Result<Option<PairValue>, PairError>> = pool.install(|| {
+        pairs
+            .par_iter()
+            .map(|&(i, j)| {
+                let r = ctx.pair::<CAP>(i, j, method);
+                let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                if k % 64 == 0 || k as usize == pairs.len() {
+                    progress(k);
+                }
+                r
+            })
+            .collect()
+    });
+    let mut out = Vec::new();
+    let mut skipped = 0;
+    for r in results {
+        match r? {
+            Some(v) => out.push(v),
+            None => skipped += 1,
+        }
+    }
+    Ok(MatrixResult {
+        areas: ctx.info.iter().map(|x| x.area.to_f64()).collect(),
+        pairs: out,
+        skipped,
+        seconds: start.elapsed().as_secs_f64(),
+    })
+}

@@ -1,0 +1,121 @@
+//! Scenes: the user's own geometry from a file (TOML or JSON, one model: [`model`]), built into
+//! surfaces and patches ([`build`]), the form-factor matrices computed pair by pair
+//! ([`matrix`]) and reported with their diagnostics ([`report`]). The file format is described
+//! field by field in `SCENES.md`.
+
+pub mod build;
+pub mod matrix;
+pub mod model;
+pub mod report;
+pub mod shape;
+
+use std::fmt;
+use std::path::Path;
+
+pub use build::{build, Scene};
+pub use model::SceneFile;
+
+/// A scene file that cannot be used: the file, the line where known, the field, what is wrong.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SceneError {
+    /// The file.
+    pub file: String,
+    /// 1-based line, where the format tells it.
+    pub line: Option<usize>,
+    /// What is wrong, naming the surface and field.
+    pub message: String,
+}
+
+impl fmt::Display for SceneError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.line {
+            Some(line) => write!(f, "{}:{line}: {}", self.file, self.message),
+            None => write!(f, "{}: {}", self.file, self.message),
+        }
+    }
+}
+
+impl std::error::Error for SceneError {}
+
+/// The formats a scene file can be in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    /// TOML (`.toml`, and any other extension).
+    Toml,
+    /// JSON (`.json`).
+    Json,
+}
+
+impl Format {
+    /// By the file's extension: `.json` is JSON, everything else TOML.
+    #[must_use]
+    pub fn of(path: &Path) -> Self {
+        match path.extension().and_then(|e| e.to_str()) {
+            Some(e) if e.eq_ignore_ascii_case("json") => Self::Json,
+            _ => Self::Toml,
+        }
+    }
+}
+
+fn one_line(s: &str) -> String {
+    s.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+/// 1-based line of byte `offset` in `text`.
+fn line_of(text: &str, offset: usize) -> usize {
+    text.get(..offset.min(text.len())).map_or(1, |t| t.matches('\n').count() + 1)
+}
+
+/// The line of the `k`-th `[[surface]]` table of a TOML text (0-based k), if it has one.
+fn surface_line(text: &str, k: usize) -> Option<usize> {
+    text.lines().enumerate().filter(|(_, l)| l.trim_start().starts_with("[[surface]]")).nth(k).map(|(n, _)| n + 1)
+}
+
+/// Parses a scene text in `format`; `file` names it in errors.
+pub fn parse(text: &str, format: Format, file: &str) -> Result<SceneFile, SceneError> {
+    match format {
+        Format::Toml => toml::from_str::<SceneFile>(text).map_err(|e| SceneError {
+            file: file.to_string(),
+            line: e.span().map(|s| line_of(text, s.start)),
+            message: one_line(e.message()),
+        }),
+        Format::Json => serde_json::from_str::<SceneFile>(text).map_err(|e| {
+            let message = one_line(&e.to_string());
+            // serde_json appends " at line L column C": the line goes in front instead.
+            let message = message.split(" at line ").next().unwrap_or(&message).to_string();
+            SceneError { file: file.to_string(), line: (e.line() > 0).then_some(e.line()), message }
+        }),
+    }
+}
+
+/// Parses and builds a scene text.
+pub fn from_text(text: &str, format: Format, file: &str) -> Result<Scene, SceneError> {
+    let model = parse(text, format, file)?;
+    build(&model).map_err(|e| {
+        let line = if format == Format::Toml { surface_line(text, e.entry) } else { None };
+        let who = if e.name.is_empty() {
+            format!("surface #{}", e.entry + 1)
+        } else {
+            format!("surface #{} '{}'", e.entry + 1, e.name)
+        };
+        let message = if e.field.is_empty() {
+            format!("{who}: {}", e.message)
+        } else if e.field == "surface" {
+            e.message.clone()
+        } else {
+            format!("{who}: field `{}` {}", e.field, e.message)
+        };
+        SceneError { file: file.to_string(), line, message }
+    })
+}
+
+/// Reads, parses and builds a scene file.
+pub fn load(path: &Path) -> Result<Scene, SceneError> {
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| SceneError {
+        file: file.clone(),
+        line: None,
+        message: format!("cannot read: {e}"),
+    })?;
+    from_text(&text, Format::of(path), &file)
+}

@@ -1,0 +1,274 @@
+//! The surfaces a scene is made of: [`Geom`], the geometry in f64 as the file gave it (the
+//! source of truth, with what the scene engine needs besides the kernel: the occluder of a
+//! whole surface, the plane of a flat one, conservative bounds on a patch's signed distance
+//! from a plane), and [`Shape`], the kernel surface it becomes in the working precision.
+
+use pdm_kernel::{
+    vec3, AnyOccluder, BezierPatch, Cone, Cylinder, Disk, Frame, Parallelogram, ParamRect, Patch, PdmError, Real, Side,
+    Sphere, Surface, Vec3,
+};
+
+/// One kernel surface of a scene: a built-in kind.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Shape<T> {
+    /// A parallelogram (rectangle).
+    Parallelogram(Parallelogram<T>),
+    /// A disk or annulus (sectors by the patch's parameter range).
+    Disk(Disk<T>),
+    /// A sphere (zones and lunes by the parameter range).
+    Sphere(Sphere<T>),
+    /// An open tube.
+    Cylinder(Cylinder<T>),
+    /// A cone or frustum.
+    Cone(Cone<T>),
+    /// A bicubic Bézier patch.
+    Bezier(BezierPatch<T>),
+}
+
+macro_rules! each {
+    ($self:expr, $s:ident => $e:expr) => {
+        match $self {
+            Shape::Parallelogram($s) => $e,
+            Shape::Disk($s) => $e,
+            Shape::Sphere($s) => $e,
+            Shape::Cylinder($s) => $e,
+            Shape::Cone($s) => $e,
+            Shape::Bezier($s) => $e,
+        }
+    };
+}
+
+impl<T: Real> Surface<T> for Shape<T> {
+    fn domain(&self) -> ParamRect<T> {
+        each!(self, s => s.domain())
+    }
+    fn point(&self, t: T, s: T) -> Vec3<T> {
+        each!(self, g => g.point(t, s))
+    }
+    fn normal(&self, t: T, s: T) -> Vec3<T> {
+        each!(self, g => g.normal(t, s))
+    }
+    fn point_and_normal(&self, t: T, s: T) -> (Vec3<T>, Vec3<T>) {
+        each!(self, g => g.point_and_normal(t, s))
+    }
+    fn affine_map(&self) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {
+        each!(self, g => g.affine_map())
+    }
+    fn point_and_partials(&self, t: T, s: T) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {
+        each!(self, g => g.point_and_partials(t, s))
+    }
+}
+
+/// A plane n̂·(x − o) = 0 with unit normal n̂ (f64).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Plane {
+    /// A point of the plane.
+    pub origin: Vec3<f64>,
+    /// Unit normal.
+    pub normal: Vec3<f64>,
+}
+
+impl Plane {
+    /// Signed distance of x from the plane.
+    #[must_use]
+    pub fn distance(&self, x: Vec3<f64>) -> f64 {
+        self.normal.dot(x - self.origin)
+    }
+}
+
+/// A parameter rectangle in f64.
+pub type Rect = ParamRect<f64>;
+
+/// One surface's geometry in f64, after rotation and translation, with its radiating side.
+/// The fields are the kernel constructors' arguments of the same names.
+#[allow(missing_docs)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Geom {
+    /// g(t, s) = origin + t·edge_t + s·edge_s on [0, 1]², radiating towards edge_t × edge_s.
+    Parallelogram { origin: Vec3<f64>, edge_t: Vec3<f64>, edge_s: Vec3<f64> },
+    /// The annulus r ∈ [inner, outer] around `center` in the plane normal to `frame.axis`,
+    /// radiating towards the axis; t = r, s = θ.
+    Disk { center: Vec3<f64>, frame: Frame<f64>, inner: f64, outer: f64 },
+    /// t = φ from the axis, s = θ; `inner`: radiating inwards.
+    Sphere { center: Vec3<f64>, radius: f64, frame: Frame<f64>, inner: bool },
+    /// t = θ, s = z ∈ [0, height].
+    Cylinder { base: Vec3<f64>, frame: Frame<f64>, radius: f64, height: f64, inner: bool },
+    /// t = θ, s = z; radius r₀ + (r₁ − r₀) z / h.
+    Cone { base: Vec3<f64>, frame: Frame<f64>, base_radius: f64, top_radius: f64, height: f64, inner: bool },
+    /// Control net, rows along t.
+    Bezier { control: [[Vec3<f64>; 4]; 4] },
+}
+
+/// Bounds [min, max] of a cos θ + b sin θ over θ ∈ [θ₀, θ₁] (exact: the ends and the
+/// stationary points inside).
+fn trig_range(a: f64, b: f64, t0: f64, t1: f64) -> (f64, f64) {
+    let f = |t: f64| a * t.cos() + b * t.sin();
+    let (mut lo, mut hi) = (f(t0).min(f(t1)), f(t0).max(f(t1)));
+    if a != 0.0 || b != 0.0 {
+        let peak = b.atan2(a);
+        let first = ((t0 - peak) / core::f64::consts::PI).ceil();
+        let last = ((t1 - peak) / core::f64::consts::PI).floor();
+        let mut k = first;
+        while k <= last {
+            let v = f(peak + k * core::f64::consts::PI);
+            lo = lo.min(v);
+            hi = hi.max(v);
+            k += 1.0;
+        }
+    }
+    (lo, hi)
+}
+
+fn to_t<T: Real>(v: Vec3<f64>) -> Vec3<T> {
+    vec3(T::from_f64(v.x), T::from_f64(v.y), T::from_f64(v.z))
+}
+
+fn side(inner: bool) -> Side {
+    if inner {
+        Side::Inner
+    } else {
+        Side::Outer
+    }
+}
+
+impl Geom {
+    /// The kernel surface in precision `T` (its constructors check the geometry once more).
+    pub fn shape<T: Real>(&self) -> Result<Shape<T>, PdmError> {
+        let r = T::from_f64;
+        Ok(match *self {
+            Self::Parallelogram { origin, edge_t, edge_s } => {
+                Shape::Parallelogram(Parallelogram::new(to_t(origin), to_t(edge_t), to_t(edge_s))?)
+            }
+            Self::Disk { center, frame, inner, outer } => {
+                Shape::Disk(Disk::annulus(to_t(center), to_t(frame.axis), r(inner), r(outer))?)
+            }
+            Self::Sphere { center, radius, frame, inner } => {
+                let frame = Frame { u: to_t(frame.u), w: to_t(frame.w), axis: to_t(frame.axis) };
+                Shape::Sphere(Sphere::with_frame(to_t(center), r(radius), frame, side(inner))?)
+            }
+            Self::Cylinder { base, frame, radius, height, inner } => {
+                Shape::Cylinder(Cylinder::new(to_t(base), to_t(frame.axis), r(radius), r(height), side(inner))?)
+            }
+            Self::Cone { base, frame, base_radius, top_radius, height, inner } => Shape::Cone(Cone::new(
+                to_t(base),
+                to_t(frame.axis),
+                r(base_radius),
+                r(top_radius),
+                r(height),
+                side(inner),
+            )?),
+            Self::Bezier { control } => Shape::Bezier(BezierPatch::new(control.map(|row| row.map(to_t)))?),
+        })
+    }
+
+    /// The parameter domain of the whole kind (the file's ranges select a part of it).
+    #[must_use]
+    pub fn domain(&self) -> Rect {
+        let two_pi = 2.0 * core::f64::consts::PI;
+        let (t1, s1) = match *self {
+            Self::Parallelogram { .. } | Self::Bezier { .. } => (1.0, 1.0),
+            Self::Disk { outer, .. } => (outer, two_pi),
+            Self::Sphere { .. } => (core::f64::consts::PI, two_pi),
+            Self::Cylinder { height, .. } | Self::Cone { height, .. } => (two_pi, height),
+        };
+        let t0 = match *self {
+            Self::Disk { inner, .. } => inner,
+            _ => 0.0,
+        };
+        ParamRect { t0, t1, s0: 0.0, s1 }
+    }
+
+    /// The plane of a flat kind (parallelogram, disk), its normal on the radiating side.
+    #[must_use]
+    pub fn plane(&self) -> Option<Plane> {
+        match *self {
+            Self::Parallelogram { origin, edge_t, edge_s } => {
+                let n = edge_t.cross(edge_s);
+                Some(Plane { origin, normal: n.scale(1.0 / n.norm()) })
+            }
+            Self::Disk { center, frame, .. } => Some(Plane { origin: center, normal: frame.axis }),
+            _ => None,
+        }
+    }
+
+    /// Whether the radiating side is concave (the inside of a sphere, tube or cone): such a
+    /// surface can hide parts of the scene from its own patches.
+    #[must_use]
+    pub fn concave(&self) -> bool {
+        match *self {
+            Self::Sphere { inner, .. } | Self::Cylinder { inner, .. } | Self::Cone { inner, .. } => inner,
+            _ => false,
+        }
+    }
+
+    /// Conservative bounds [min, max] of the signed distance from `plane` over the patch on
+    /// `rect`: exact for parallelograms, disks, tubes and cones (closed-form extremes), the
+    /// patch's enclosing ball ([`Patch::enclosing_ball`]) for spheres and Bézier patches.
+    #[must_use]
+    pub fn distance_range(&self, rect: Rect, plane: &Plane) -> (f64, f64) {
+        let n = plane.normal;
+        match *self {
+            Self::Parallelogram { origin, edge_t, edge_s } => {
+                let mut lo = f64::MAX;
+                let mut hi = -f64::MAX;
+                for (t, s) in [(rect.t0, rect.s0), (rect.t1, rect.s0), (rect.t0, rect.s1), (rect.t1, rect.s1)] {
+                    let d = plane.distance(origin + edge_t.scale(t) + edge_s.scale(s));
+                    lo = lo.min(d);
+                    hi = hi.max(d);
+                }
+                (lo, hi)
+            }
+            Self::Disk { center, frame, .. } => {
+                let c = plane.distance(center);
+                let (lo, hi) = trig_range(n.dot(frame.u), n.dot(frame.w), rect.s0, rect.s1);
+                // r ≥ 0 scales the angular part: the extremes lie at the radial ends.
+                let (a, b) = (rect.t0, rect.t1);
+                (c + (a * lo).min(b * lo), c + (a * hi).max(b * hi))
+            }
+            Self::Cylinder { base, frame, radius, .. } => {
+                let c = plane.distance(base);
+                let (lo, hi) = trig_range(n.dot(frame.u), n.dot(frame.w), rect.t0, rect.t1);
+                let g = n.dot(frame.axis);
+                let (z0, z1) = ((g * rect.s0).min(g * rect.s1), (g * rect.s0).max(g * rect.s1));
+                (c + radius * lo + z0, c + radius * hi + z1)
+            }
+            Self::Cone { base, frame, base_radius, top_radius, height, .. } => {
+                // Linear in z for each θ: the extremes lie on the two z ends.
+                let c = plane.distance(base);
+                let (lo, hi) = trig_range(n.dot(frame.u), n.dot(frame.w), rect.t0, rect.t1);
+                let g = n.dot(frame.axis);
+                let mut range = (f64::MAX, -f64::MAX);
+                for z in [rect.s0, rect.s1] {
+                    let radius = base_radius + (top_radius - base_radius) * z / height;
+                    range.0 = range.0.min(c + radius * lo + g * z);
+                    range.1 = range.1.max(c + radius * hi + g * z);
+                }
+                range
+            }
+            Self::Sphere { .. } | Self::Bezier { .. } => match self.shape::<f64>() {
+                Ok(shape) => match Patch::new(&shape, rect) {
+                    Ok(patch) => {
+                        let ball = patch.enclosing_ball();
+                        let c = plane.distance(ball.center);
+                        (c - ball.radius, c + ball.radius)
+                    }
+                    Err(_) => (-f64::MAX, f64::MAX),
+                },
+                Err(_) => (-f64::MAX, f64::MAX),
+            },
+        }
+    }
+}
+
+/// The built-in occluder of a whole surface in precision `T`, if the kernel has one for its
+/// kind.
+#[must_use]
+pub fn occluder_of<T: Real>(shape: &Shape<T>) -> Option<AnyOccluder<T>> {
+    match *shape {
+        Shape::Parallelogram(p) => Some(AnyOccluder::Parallelogram(p)),
+        Shape::Disk(d) => Some(AnyOccluder::Disk(d)),
+        Shape::Sphere(s) => Some(AnyOccluder::Sphere(s)),
+        Shape::Cylinder(c) => Some(AnyOccluder::Cylinder(c)),
+        Shape::Cone(_) | Shape::Bezier(_) => None,
+    }
+}
