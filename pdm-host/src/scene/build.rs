@@ -7,7 +7,7 @@ use super::model::{fields_of, Kind, SceneFile, SideSpec, SurfaceSpec};
 use super::shape::{Geom, Rect};
 
 /// Most patches a scene may have (the matrix has patches² entries).
-pub const MAX_PATCHES: usize = 20_000;
+pub const MAX_PATCHES: usize = 5_000;
 /// Most patches along one side of one piece.
 pub const MAX_SUBDIVISION: usize = 1_000;
 

@@ -361,7 +361,7 @@ fn compute_with<T: Real, const CAP: usize>(
             .map(|&(i, j)| {
                 let r = ctx.pair::<CAP>(i, j, method);
                 let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-                if k % 64 == 0 || k as usize == pairs.len() {
+                if k.is_multiple_of(64) || k as usize == pairs.len() {
                     progress(k);
                 }
                 r

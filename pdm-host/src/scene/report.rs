@@ -229,9 +229,9 @@ pub fn text(report: &SceneReport) -> String {
     }
     if let Some(errors) = &s.errors {
         out += "\nEstimated absolute error of each entry:\n";
-        for i in 0..s.names.len() {
-            out += &format!("{:width$}  {:>12}", s.names[i], "");
-            for e in &errors[i] {
+        for (name, row) in s.names.iter().zip(errors) {
+            out += &format!("{name:width$}  {:>12}", "");
+            for e in row {
                 out += &format!("  {e:>width$.1e}");
             }
             out += "\n";

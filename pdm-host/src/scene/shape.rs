@@ -82,6 +82,7 @@ pub type Rect = ParamRect<f64>;
 /// One surface's geometry in f64, after rotation and translation, with its radiating side.
 /// The fields are the kernel constructors' arguments of the same names.
 #[allow(missing_docs)]
+#[allow(clippy::large_enum_variant)] // a scene holds a few of them; Copy matters more
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Geom {
     /// g(t, s) = origin + t·edge_t + s·edge_s on [0, 1]², radiating towards edge_t × edge_s.

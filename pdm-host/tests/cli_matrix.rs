@@ -1,0 +1,67 @@
+//! `pdm-ff matrix` end to end: output files, exit codes, one-line errors.
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing, clippy::panic)]
+
+use std::process::{Command, Output};
+
+fn pdm(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_pdm-ff")).args(args).output().expect("run pdm-ff")
+}
+
+fn example(name: &str) -> String {
+    format!("{}/../examples/scenes/{name}", env!("CARGO_MANIFEST_DIR"))
+}
+
+#[test]
+fn writes_json_and_csv_atomically() {
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("cube.json");
+    let out = pdm(&["matrix", &example("cube.toml"), "--tolerance", "1e-8", "--output", json.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("row sum") && stdout.contains("floor"), "{stdout}");
+    let value: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    let names = value["surfaces"]["names"].as_array().unwrap();
+    assert_eq!(names.len(), 6);
+    let f = value["surfaces"]["factors"][0][1].as_f64().unwrap();
+    let exact = pdm_host::reference::closed_form::parallel_rectangles(1.0, 1.0, 1.0); // C-11
+    assert!((f - exact).abs() < 1e-8, "{f}");
+    assert_eq!(value["patches"]["names"].as_array().unwrap().len(), 24);
+    // Only the output file is left in the folder (no temporary files).
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+
+    let csv = dir.path().join("cube.csv");
+    let out = pdm(&["matrix", &example("cube.toml"), "--order", "8", "--output", csv.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    assert!(text.starts_with("level,from,to,area_from,factor,error\nsurface,floor,ceiling,"), "{text}");
+    assert_eq!(text.lines().filter(|l| l.starts_with("surface,")).count(), 30);
+}
+
+#[test]
+fn bad_input_is_one_line_and_exit_code_2() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(
+        &bad,
+        "[[surface]]\nname = \"d\"\nkind = \"disk\"\ncenter = [0, 0, 0]\nnormal = [0, 0, 1]\nradius = -1\n",
+    )
+    .unwrap();
+    for args in [
+        vec!["matrix", bad.to_str().unwrap()],
+        vec!["matrix", "/nonexistent/scene.toml"],
+        vec!["matrix", bad.to_str().unwrap(), "--tolerance", "-1"],
+    ] {
+        let out = pdm(&args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
+        assert!(stderr.starts_with("error:"), "{stderr}");
+    }
+    let out = pdm(&["matrix", bad.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("bad.toml:1: surface #1 'd': field `radius` -1 must be positive"), "{stderr}");
+    // An unknown output format is refused before any work, and nothing is written.
+    let out = pdm(&["matrix", &example("cube.toml"), "--output", dir.path().join("m.xlsx").to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(!dir.path().join("m.xlsx").exists());
+}
