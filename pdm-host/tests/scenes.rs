@@ -209,8 +209,8 @@ fn bad_scenes_are_named_errors() {
         (format!("{rect}\n{rect}"), &["#2 'a'", "`name`", "already used"]),
         (format!("{rect}radius = 1\n"), &["`radius`", "does not belong to kind rectangle"]),
         (
-            "[[surface]]\nname = \"c\"\nkind = \"cone\"\nbase = [0, 0, 0]\naxis = [0, 0, 1]\nbase_radius = 1\ntop_radius = 0\nheight = 1\n".to_string(),
-            &["`occludes`", "no occluder for a cone"],
+            "[[surface]]\nname = \"c\"\nkind = \"cone\"\nbase = [0, 0, 0]\naxis = [0, 0, 1]\nbase_radius = 1\ntop_radius = 0\nheight = 1\ntheta = [0, 90]\n".to_string(),
+            &["`occludes`", "no occluder for a part of a cone"],
         ),
         (format!("{rect}subdivide = [0, 3]\n"), &["`subdivide`"]),
         (format!("{rect}subdivide = [1000, 1000]\n"), &["more than 5000 patches"]),
@@ -259,4 +259,49 @@ mod parser {
             let _ = from_text(&text, Format::Toml, "p.toml");
         }
     }
+}
+
+/// Two plates with a blocker between them, once as a kernel shape with a closed-form
+/// occluder and once as another kind describing the same surface: a frustum with equal radii
+/// is the tube, a flat Bézier net on a uniform grid is the rectangle (to the Bézier occluder's
+/// stated tolerance). Any error in the cone or Bézier occluder changes the shadow.
+#[test]
+fn cone_and_bezier_occluders_cast_the_shadows_of_their_twins() {
+    let plates = r#"
+[[surface]]
+name = "lower"
+kind = "rectangle"
+origin = [-1, -1, 0]
+edge_t = [2, 0, 0]
+edge_s = [0, 2, 0]
+
+[[surface]]
+name = "upper"
+kind = "rectangle"
+origin = [-1, -1, 2]
+edge_t = [0, 2, 0]
+edge_s = [2, 0, 0]
+"#;
+    let tube = "\n[[surface]]\nname = \"b\"\nkind = \"cylinder\"\nbase = [-1.5, 0, 1]\naxis = [1, 0, 0]\nradius = 0.3\nheight = 3\n";
+    let cone = "\n[[surface]]\nname = \"b\"\nkind = \"cone\"\nbase = [-1.5, 0, 1]\naxis = [1, 0, 0]\nbase_radius = 0.3\ntop_radius = 0.3\nheight = 3\n";
+    let square = "\n[[surface]]\nname = \"b\"\nkind = \"rectangle\"\norigin = [-0.4, -0.3, 1]\nedge_t = [0.9, 0, 0.2]\nedge_s = [0, 0.7, 0]\n";
+    let mut net = String::from("\n[[surface]]\nname = \"b\"\nkind = \"bezier\"\ncontrol = [");
+    for i in 0..4 {
+        net += "[";
+        for j in 0..4 {
+            let (u, v) = (i as f64 / 3.0, j as f64 / 3.0);
+            net += &format!("[{}, {}, {}],", -0.4 + 0.9 * u, -0.3 + 0.7 * v, 1.0 + 0.2 * u);
+        }
+        net += "],";
+    }
+    net += "]\n";
+    let method = PairMethod::Order { order: 8, singular_order: 8 };
+    let f = |extra: &str| factor(&run(&scene(&format!("{plates}{extra}")), method), "lower", "upper");
+    let open = closed_form::parallel_rectangles(2.0, 2.0, 2.0); // C-11
+    let (with_tube, with_cone) = (f(tube), f(cone));
+    assert!(with_tube < open * 0.95, "the tube casts a shadow: {with_tube} vs {open}");
+    assert!((with_tube - with_cone).abs() <= 1e-9 * with_tube, "{with_tube} vs {with_cone}");
+    let (with_square, with_net) = (f(square), f(&net));
+    assert!(with_square < open * 0.95, "{with_square} vs {open}");
+    assert!((with_square - with_net).abs() <= 1e-6 * with_square, "{with_square} vs {with_net}");
 }

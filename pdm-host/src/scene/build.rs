@@ -375,6 +375,9 @@ pub fn build(file: &SceneFile) -> Result<Scene, EntryError> {
             let mut pieces = Vec::new();
             for (geom, rect) in geometry(i, spec, flip, &place)? {
                 let grid = match (spec.subdivide, spec.patch_size) {
+                    // A flipped Bézier net is transposed: its grid too, so that its cells are
+                    // the front's.
+                    (Some([m, n]), _) if flip && spec.kind == Kind::Bezier => (n, m),
                     (Some([m, n]), _) => (m, n),
                     (None, Some(size)) => {
                         let count = |along_t| (mid_length(&geom, rect, along_t) / size).ceil().max(1.0);
@@ -398,25 +401,17 @@ pub fn build(file: &SceneFile) -> Result<Scene, EntryError> {
                 pieces.push(Piece { geom, rect, grid });
             }
             let occludes = spec.occludes.unwrap_or(true);
-            if occludes {
-                let whole = pieces.len() == 1 && pieces.iter().all(|p| p.rect == p.geom.domain());
-                let kind_has = matches!(spec.kind, Kind::Rectangle | Kind::Disk | Kind::Sphere | Kind::Cylinder);
-                if !kind_has || !whole {
-                    let what = if kind_has {
-                        format!("a part of a {} (a `theta` or `phi` range)", spec.kind.name())
-                    } else {
-                        format!("a {} surface", spec.kind.name())
-                    };
-                    return fail(
-                        i,
-                        spec,
-                        "occludes",
-                        format!(
-                            "is true (the default), but pdm has no occluder for {what}; set `occludes = false` \
-                             (exact only if it hides nothing between other surfaces)"
-                        ),
-                    );
-                }
+            if occludes && !pieces.iter().all(|p| p.rect == p.geom.domain()) {
+                return fail(
+                    i,
+                    spec,
+                    "occludes",
+                    format!(
+                        "is true (the default), but pdm has no occluder for a part of a {} (a `theta` or `phi` \
+                         range); set `occludes = false` (exact only if it hides nothing between other surfaces)",
+                        spec.kind.name()
+                    ),
+                );
             }
             surfaces.push(SceneSurface {
                 name: format!("{}{suffix}", spec.name),

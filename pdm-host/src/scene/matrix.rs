@@ -165,7 +165,8 @@ fn inside_solid(solid: &Geom, geom: &Geom, p: &ScenePatch, ball: (Vec3<f64>, f64
 struct Context<'s, T> {
     scene: &'s Scene,
     shapes: Vec<Vec<Shape<T>>>,
-    occluders: Vec<Option<AnyOccluder<T>>>,
+    /// Per surface, one occluder per piece (empty: the surface does not occlude).
+    occluders: Vec<Vec<AnyOccluder<T>>>,
     info: Vec<PatchInfo<T>>,
     balls: Vec<(Vec3<f64>, f64)>,
     planes: Vec<Option<Plane>>,
@@ -214,46 +215,62 @@ impl<T: Real> Context<'_, T> {
         if si.entry == sj.entry && pi.surface == pj.surface && !gi.concave() && !matches!(gi, Geom::Bezier { .. }) {
             return Plan::Skip;
         }
+        // The two sides of one sheet or closed surface: a segment between two of its points is
+        // a chord on the concave side of both (flat, sphere, tube, cone), which the convex side
+        // does not face. A Bézier sheet is taken to be such a part of a convex surface (a dish,
+        // a curved panel); a wavy sheet whose front sees its own back is not supported
+        // (SCENES.md).
+        if si.entry == sj.entry && pi.surface != pj.surface {
+            return Plan::Skip;
+        }
         if self.behind(i, j) || self.behind(j, i) {
             return Plan::Skip;
         }
         let (bi, bj) = (&self.info[i].ball, &self.info[j].ball);
         let mut list = Vec::new();
         for (k, s) in scene.surfaces.iter().enumerate() {
-            let Some(occluder) = self.occluders[k] else { continue };
-            // The two sides of one entry are one occluder: take it once.
-            if scene.surfaces[..k].iter().enumerate().any(|(m, o)| o.entry == s.entry && self.occluders[m].is_some()) {
+            if self.occluders[k].is_empty() {
                 continue;
             }
-            let geom = &s.pieces[0].geom;
+            // The two sides of one entry are one occluder: take it once.
+            if scene.surfaces[..k].iter().enumerate().any(|(m, o)| o.entry == s.entry && !self.occluders[m].is_empty())
+            {
+                continue;
+            }
             if s.entry == si.entry || s.entry == sj.entry {
-                // A segment between two points of one surface is a chord of its solid; a flat
-                // sheet or a convex side never blocks a segment that starts on it and passes
-                // the facing test; a concave side blocks only segments that leave its solid.
+                // A segment between two points of one surface is a chord of its solid (a Bézier
+                // sheet is taken to be part of a convex surface, SCENES.md); a flat sheet or a
+                // convex side never blocks a segment that starts on it and passes the facing
+                // test; a concave side (or a Bézier piece that bends both ways) blocks only
+                // segments that leave its solid.
                 if si.entry == sj.entry {
                     continue;
                 }
-                let (on, other) = if s.entry == si.entry { (pi, j) } else { (pj, i) };
-                let solid = scene.geom(on);
-                if !solid.concave() {
-                    continue;
-                }
-                let po = &scene.patches[other];
-                if inside_solid(solid, scene.geom(po), po, self.balls[other], self.tol) {
-                    continue;
-                }
-            }
-            if !occluder.may_block_between(bi, bj) {
-                continue;
-            }
-            if let Some(plane) = geom.plane() {
-                let (lo_i, hi_i) = gi.distance_range(pi.rect, &plane);
-                let (lo_j, hi_j) = gj.distance_range(pj.rect, &plane);
-                if (lo_i >= -self.tol && lo_j >= -self.tol) || (hi_i <= self.tol && hi_j <= self.tol) {
-                    continue;
+                {
+                    let (on, other) = if s.entry == si.entry { (pi, j) } else { (pj, i) };
+                    let solid = scene.geom(on);
+                    if !solid.concave() {
+                        continue;
+                    }
+                    let po = &scene.patches[other];
+                    if inside_solid(solid, scene.geom(po), po, self.balls[other], self.tol) {
+                        continue;
+                    }
                 }
             }
-            list.push(occluder);
+            for (occluder, piece) in self.occluders[k].iter().zip(&s.pieces) {
+                if !occluder.may_block_between(bi, bj) {
+                    continue;
+                }
+                if let Some(plane) = piece.geom.plane() {
+                    let (lo_i, hi_i) = gi.distance_range(pi.rect, &plane);
+                    let (lo_j, hi_j) = gj.distance_range(pj.rect, &plane);
+                    if (lo_i >= -self.tol && lo_j >= -self.tol) || (hi_i <= self.tol && hi_j <= self.tol) {
+                        continue;
+                    }
+                }
+                list.push(*occluder);
+            }
         }
         Plan::Integrate(list)
     }
@@ -332,9 +349,10 @@ fn compute_with<T: Real, const CAP: usize>(
     for s in &scene.surfaces {
         let first = scene.patches.iter().position(|p| scene.surfaces[p.surface].name == s.name).unwrap_or(0);
         let list = s.pieces.iter().map(|p| p.geom.shape::<T>()).collect::<Result<Vec<_>, _>>().map_err(at(first))?;
-        // Whole-surface occluders exist for single-piece kinds only (the scene's builder
+        // Every piece of an occluding surface is one (the scene's builder refuses `occludes` on
+        // parts of surfaces, which have none).
         // refuses `occludes` where there is none).
-        occluders.push(if s.occludes && list.len() == 1 { list.first().and_then(occluder_of) } else { None });
+        occluders.push(if s.occludes { list.iter().filter_map(occluder_of).collect() } else { Vec::new() });
         shapes.push(list);
     }
     let mut ctx =

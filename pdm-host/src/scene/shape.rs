@@ -192,12 +192,29 @@ impl Geom {
         }
     }
 
-    /// Whether the radiating side is concave (the inside of a sphere, tube or cone): such a
-    /// surface can hide parts of the scene from its own patches.
+    /// Whether the radiating side may be concave (the inside of a sphere, tube or cone; a Bézier
+    /// piece unless it is sampled convex): such a surface can hide parts of the scene from its
+    /// own patches.
     #[must_use]
     pub fn concave(&self) -> bool {
         match *self {
             Self::Sphere { inner, .. } | Self::Cylinder { inner, .. } | Self::Cone { inner, .. } => inner,
+            Self::Bezier { .. } => {
+                // Sampled: the radiating side is convex if every sample of a 9 × 9 grid lies
+                // behind (or on) the tangent plane at every other sample (the surface of a
+                // convex solid); otherwise it may hide parts of the scene from its own patches.
+                let Ok(shape) = self.shape::<f64>() else { return true };
+                use pdm_kernel::Surface as _;
+                const N: usize = 9;
+                let samples: Vec<_> = (0..N * N)
+                    .map(|k| shape.point_and_normal((k / N) as f64 / (N - 1) as f64, (k % N) as f64 / (N - 1) as f64))
+                    .collect();
+                let size = samples.iter().map(|(p, _)| (*p - samples[0].0).norm()).fold(0.0, f64::max);
+                samples.iter().any(|&(c, n)| {
+                    let length = n.norm();
+                    !(length > 0.0) || samples.iter().any(|&(p, _)| n.dot(p - c) / length > 1e-9 * size)
+                })
+            }
             _ => false,
         }
     }
@@ -261,8 +278,8 @@ impl Geom {
     }
 }
 
-/// The built-in occluder of a whole surface in precision `T`, if the kernel has one for its
-/// kind.
+/// The built-in occluder of a whole surface in precision `T` (the Bézier patch's to
+/// `pdm_kernel::visibility::BEZIER_FLATNESS`).
 #[must_use]
 pub fn occluder_of<T: Real>(shape: &Shape<T>) -> Option<AnyOccluder<T>> {
     match *shape {
@@ -270,6 +287,7 @@ pub fn occluder_of<T: Real>(shape: &Shape<T>) -> Option<AnyOccluder<T>> {
         Shape::Disk(d) => Some(AnyOccluder::Disk(d)),
         Shape::Sphere(s) => Some(AnyOccluder::Sphere(s)),
         Shape::Cylinder(c) => Some(AnyOccluder::Cylinder(c)),
-        Shape::Cone(_) | Shape::Bezier(_) => None,
+        Shape::Cone(c) => Some(AnyOccluder::Cone(c)),
+        Shape::Bezier(b) => Some(AnyOccluder::Bezier(b)),
     }
 }

@@ -16,6 +16,10 @@ pub enum AnyOccluder<T> {
     Disk(Disk<T>),
     /// An open cylinder.
     Cylinder(Cylinder<T>),
+    /// A cone or frustum.
+    Cone(crate::surface::Cone<T>),
+    /// A bicubic Bézier patch (to a tolerance: [`super::BEZIER_FLATNESS`]).
+    Bezier(crate::surface::BezierPatch<T>),
 }
 
 impl<T: Real> Occluder<T> for AnyOccluder<T> {
@@ -25,6 +29,8 @@ impl<T: Real> Occluder<T> for AnyOccluder<T> {
             Self::Parallelogram(o) => o.blocks(p, q),
             Self::Disk(o) => o.blocks(p, q),
             Self::Cylinder(o) => o.blocks(p, q),
+            Self::Cone(o) => o.blocks(p, q),
+            Self::Bezier(o) => o.blocks(p, q),
         }
     }
     fn may_block_between(&self, a: &Ball<T>, b: &Ball<T>) -> bool {
@@ -33,6 +39,8 @@ impl<T: Real> Occluder<T> for AnyOccluder<T> {
             Self::Parallelogram(o) => o.may_block_between(a, b),
             Self::Disk(o) => o.may_block_between(a, b),
             Self::Cylinder(o) => o.may_block_between(a, b),
+            Self::Cone(o) => o.may_block_between(a, b),
+            Self::Bezier(o) => o.may_block_between(a, b),
         }
     }
     #[cfg(feature = "closed-form")]
@@ -42,6 +50,8 @@ impl<T: Real> Occluder<T> for AnyOccluder<T> {
             Self::Parallelogram(o) => o.line_polynomials(p, origin, direction, out),
             Self::Disk(o) => o.line_polynomials(p, origin, direction, out),
             Self::Cylinder(o) => o.line_polynomials(p, origin, direction, out),
+            Self::Cone(o) => o.line_polynomials(p, origin, direction, out),
+            Self::Bezier(o) => o.line_polynomials(p, origin, direction, out),
         }
     }
     #[cfg(feature = "closed-form")]

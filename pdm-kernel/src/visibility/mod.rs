@@ -7,7 +7,9 @@
 //!
 //! **Occlusion.** An [`Occluder`] answers whether the open segment P_a → P_b crosses it. The
 //! built-in shapes are exact occluders (closed-form segment intersection): [`Sphere`],
-//! [`Parallelogram`], [`Disk`] (annulus), [`Cylinder`] (open tube). Their *surface* is the
+//! [`Parallelogram`], [`Disk`] (annulus), [`Cylinder`] (open tube), [`Cone`](crate::Cone)
+//! (cone or frustum); the [`BezierPatch`](crate::BezierPatch) occludes to a stated tolerance
+//! ([`BEZIER_FLATNESS`], by subdivision of its control net). Their *surface* is the
 //! obstacle: a segment crosses it where it enters or leaves, so two points on the inside of a
 //! sphere see each other, while the same sphere blocks segments passing through it. Crossings
 //! within a relative distance [`Real::GEOMETRY_TOLERANCE`] of either end point are ignored, so
@@ -22,7 +24,7 @@
 //! built-in lists.
 //!
 //! Files: the trait and the bounding-ball tests here; one file per built-in shape
-//! (`sphere.rs`, `parallelogram.rs`, `disk.rs`, `cylinder.rs`); the root finding they share
+//! (`sphere.rs`, `parallelogram.rs`, `disk.rs`, `cylinder.rs`, `cone.rs`, `bezier.rs`); the root finding they share
 //! (`roots.rs`); the combinations (`combine.rs`).
 
 use crate::real::Real;
@@ -32,7 +34,9 @@ use crate::vec3::Vec3;
 
 pub use crate::integrand::mutually_facing;
 
+mod bezier;
 mod combine;
+mod cone;
 mod cylinder;
 mod disk;
 mod parallelogram;
@@ -41,13 +45,14 @@ mod sphere;
 #[cfg(test)]
 mod tests;
 
+pub use bezier::BEZIER_FLATNESS;
 pub use combine::AnyOccluder;
 pub(crate) use roots::polynomial_roots;
 use roots::*;
 
 /// Something that may block the line of sight between two points.
 ///
-/// Sphere, parallelogram, disk and cylinder are occluders; several combine as a tuple, an
+/// Sphere, parallelogram, disk, cylinder, cone and Bézier patch are occluders; several combine as a tuple, an
 /// array, a slice or a `heapless::Vec` (of [`AnyOccluder`] to mix kinds), and `&()` means none.
 ///
 /// ```

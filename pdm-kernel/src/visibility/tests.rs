@@ -250,3 +250,150 @@ fn sphere_hides_ball_only_when_every_segment_is_blocked() {
     assert!(!sphere.hides_ball_from(vec3(0.0, 0.0, 3.0), &Ball { center: vec3(1.9, 0.0, -3.0), radius: 0.5 }));
     assert!(!sphere.hides_ball_from(vec3(0.0, 0.0, 3.0), &Ball { center: vec3(0.0, 0.0, 1.5), radius: 0.1 }));
 }
+
+/// The cone occluder against a dense scan of the segment: the segment is blocked exactly when
+/// the sign of r(z)² − |w⊥|² changes between interior samples at heights within [0, h].
+#[test]
+fn cone_blocks_where_a_scan_finds_a_crossing() {
+    use crate::surface::Cone;
+    let (r0, r1, h) = (1.0, 0.25, 1.5);
+    let cone = Cone::new(o(), vec3(0.0, 0.0, 1.0), r0, r1, h, Side::Outer).unwrap();
+    let field = |x: Vec3<f64>| {
+        let rho = r0 + (r1 - r0) * x.z / h;
+        x.x * x.x + x.y * x.y - rho * rho
+    };
+    // A deterministic spread of segments (a small linear congruential generator), crossing,
+    // grazing, steeper and flatter than the side, inside and outside.
+    let mut state = 12345u64;
+    let mut next = || {
+        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((state >> 11) as f64 / (1u64 << 53) as f64) * 4.0 - 2.0
+    };
+    let (mut blocked, mut clear) = (0, 0);
+    for _ in 0..2000 {
+        let p = vec3(next(), next(), next() + 0.75);
+        let q = vec3(next(), next(), next() + 0.75);
+        const N: usize = 4000;
+        let mut crossings = 0;
+        let mut prev: Option<f64> = None;
+        for k in 1..N {
+            let x = p + (q - p).scale(k as f64 / N as f64);
+            let inside_height = x.z >= 0.0 && x.z <= h;
+            let v = field(x);
+            if let (Some(u), true) = (prev, inside_height) {
+                if (u < 0.0) != (v < 0.0) {
+                    crossings += 1;
+                }
+            }
+            prev = inside_height.then_some(v);
+        }
+        // Segments whose scan brushes the surface or the rims are ambiguous at this sampling.
+        let near_miss = (1..N).any(|k| {
+            let x = p + (q - p).scale(k as f64 / N as f64);
+            field(x).abs() < 1e-3 && (x.z.abs() < 1e-2 || (x.z - h).abs() < 1e-2 || x.z > 0.0 && x.z < h)
+        });
+        if crossings > 0 {
+            assert!(cone.blocks(p, q), "{p:?} -> {q:?}: the scan crosses");
+            blocked += 1;
+        } else if !near_miss {
+            assert!(!cone.blocks(p, q), "{p:?} -> {q:?}: the scan does not cross");
+            clear += 1;
+        }
+    }
+    assert!(blocked > 200 && clear > 200, "{blocked} blocked, {clear} clear");
+    // From a point of the side outwards: not blocked; through the cone: blocked.
+    assert!(!cone.blocks(vec3(1.0, 0.0, 0.0), vec3(3.0, 0.0, 0.5)));
+    assert!(cone.blocks(vec3(1.0, 0.0, 0.0), vec3(-3.0, 0.0, 0.0)));
+    // Beyond the top (the other nappe of the quadric lies past the apex of the full cone).
+    assert!(!cone.blocks(vec3(-3.0, 0.0, 3.0), vec3(3.0, 0.0, 3.0)));
+}
+
+/// The Bézier occluder on a net that is exactly a sphere-free quadratic (the paraboloid
+/// z = x² + y² over [−1, 1]², degree-elevated): a segment crosses it where the sign of
+/// z − x² − y² changes inside the square, and its own points do not block segments leaving
+/// towards either side.
+#[test]
+fn bezier_blocks_where_the_paraboloid_is_crossed() {
+    use crate::surface::BezierPatch;
+    let q = [1.0, -1.0 / 3.0, -1.0 / 3.0, 1.0];
+    let mut net = [[o(); 4]; 4];
+    for (i, row) in net.iter_mut().enumerate() {
+        for (j, p) in row.iter_mut().enumerate() {
+            *p = vec3(-1.0 + 2.0 * i as f64 / 3.0, -1.0 + 2.0 * j as f64 / 3.0, q[i] + q[j]);
+        }
+    }
+    let dish = BezierPatch::new(net).unwrap();
+    let field = |x: Vec3<f64>| x.z - x.x * x.x - x.y * x.y;
+    let inside = |x: Vec3<f64>| x.x.abs() <= 1.0 && x.y.abs() <= 1.0;
+    let mut state = 777u64;
+    let mut next = || {
+        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((state >> 11) as f64 / (1u64 << 53) as f64) * 3.0 - 1.5
+    };
+    let (mut blocked, mut clear) = (0, 0);
+    for _ in 0..1000 {
+        let p = vec3(next(), next(), next() + 1.0);
+        let r = vec3(next(), next(), next() + 1.0);
+        const N: usize = 4000;
+        let (mut crossings, mut near, mut closest) = (0, false, f64::MAX);
+        let mut prev: Option<f64> = None;
+        for k in 1..N {
+            let x = p + (r - p).scale(k as f64 / N as f64);
+            let v = field(x);
+            if inside(x) {
+                closest = closest.min(v.abs());
+                if let Some(u) = prev {
+                    if (u < 0.0) != (v < 0.0) {
+                        crossings += 1;
+                        // A crossing next to the rim may fall either side of it.
+                        near |= x.x.abs() > 0.99 || x.y.abs() > 0.99;
+                    }
+                }
+                prev = Some(v);
+            } else {
+                prev = None;
+            }
+        }
+        // A segment that grazes the surface without crossing it at this sampling.
+        near |= crossings == 0 && closest < 1e-2;
+        if near {
+            continue;
+        }
+        assert_eq!(dish.blocks(p, r), crossings > 0, "{p:?} -> {r:?}");
+        if crossings > 0 {
+            blocked += 1;
+        } else {
+            clear += 1;
+        }
+    }
+    assert!(blocked > 100 && clear > 100, "{blocked} blocked, {clear} clear");
+    // From a point of the dish: up into the bowl and down below it, not blocked; across the
+    // bowl to below the far rim, blocked.
+    let on = vec3(0.5, 0.0, 0.25);
+    assert!(!dish.blocks(on, vec3(0.4, 0.1, 2.0)));
+    assert!(!dish.blocks(on, vec3(0.6, 0.0, -1.0)));
+    assert!(dish.blocks(on, vec3(-2.0, 0.0, 1.0)));
+}
+
+/// Short chords of the dish between its own points, on its concave side, are not blocked by it
+/// (the corner triangles of the pieces around the end points lie off the surface).
+#[test]
+fn bezier_chords_of_its_own_points_are_clear() {
+    use crate::surface::{BezierPatch, Surface};
+    let q = [1.0, -1.0 / 3.0, -1.0 / 3.0, 1.0];
+    let mut net = [[o(); 4]; 4];
+    for (i, row) in net.iter_mut().enumerate() {
+        for (j, p) in row.iter_mut().enumerate() {
+            *p = vec3(-1.0 + 2.0 * i as f64 / 3.0, -1.0 + 2.0 * j as f64 / 3.0, q[i] + q[j]);
+        }
+    }
+    let dish = BezierPatch::new(net).unwrap();
+    for k in 0..200 {
+        let t = 0.05 + 0.9 * (k as f64 * 0.618_033_988_75).fract();
+        let s = 0.05 + 0.9 * (k as f64 * 0.414_213_562_37).fract();
+        for step in [1e-3, 1e-2, 0.1, 0.3] {
+            let (a, b) = (dish.point(t, s), dish.point((t + step).min(1.0), (s + step * 0.5).min(1.0)));
+            assert!(!dish.blocks(a, b), "chord ({t}, {s}) + {step}");
+        }
+    }
+}
