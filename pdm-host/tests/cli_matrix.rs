@@ -65,3 +65,43 @@ fn bad_input_is_one_line_and_exit_code_2() {
     assert_eq!(out.status.code(), Some(2));
     assert!(!dir.path().join("m.xlsx").exists());
 }
+
+/// Three slices computed separately and merged give the matrix of the whole run, value for
+/// value; a missing or repeated slice is refused.
+#[test]
+fn slices_merge_into_the_whole() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = example("closed_cylinder.toml");
+    let whole = dir.path().join("whole.json");
+    let out = pdm(&["matrix", &scene, "--order", "8", "--output", whole.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let mut parts = Vec::new();
+    for k in 1..=3 {
+        let part = dir.path().join(format!("part{k}.json"));
+        let shard = format!("{k}/3");
+        let out = pdm(&["matrix", &scene, "--order", "8", "--shard", &shard, "--output", part.to_str().unwrap()]);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        assert!(String::from_utf8_lossy(&out.stdout).starts_with(&format!("slice {k}/3 of")));
+        parts.push(part.to_str().unwrap().to_string());
+    }
+    let merged = dir.path().join("merged.json");
+    let mut args = vec!["merge"];
+    args.extend(parts.iter().map(String::as_str));
+    args.extend(["--output", merged.to_str().unwrap()]);
+    let out = pdm(&args);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let read = |p: &std::path::Path| -> serde_json::Value { serde_json::from_slice(&std::fs::read(p).unwrap()).unwrap() };
+    let (a, b) = (read(&whole), read(&merged));
+    assert_eq!(a["surfaces"]["factors"], b["surfaces"]["factors"]);
+    assert_eq!(a["patches"]["factors"], b["patches"]["factors"]);
+    assert_eq!(a["diagnostics"]["pairs_integrated"], b["diagnostics"]["pairs_integrated"]);
+
+    let out = pdm(&["merge", &parts[0], &parts[1]]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("slice 3/3 is missing"));
+    let out = pdm(&["merge", &parts[0], &parts[1], &parts[1]]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("slice 2/3 is given twice"));
+    let out = pdm(&["matrix", &scene, "--shard", "4/3", "--output", "x.json"]);
+    assert_eq!(out.status.code(), Some(2));
+}

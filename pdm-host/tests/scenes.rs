@@ -13,7 +13,7 @@ fn scene(text: &str) -> Scene {
 }
 
 fn run(scene: &Scene, method: PairMethod) -> SceneReport {
-    let result = compute::<f64>(scene, method, 0, &|_| {}).unwrap_or_else(|e| panic!("{e:?}"));
+    let result = compute::<f64>(scene, method, None, 0, &|_| {}).unwrap_or_else(|e| panic!("{e:?}"));
     assemble(scene, &result, method)
 }
 
@@ -304,4 +304,36 @@ edge_s = [2, 0, 0]
     let (with_square, with_net) = (f(square), f(&net));
     assert!(with_square < open * 0.95, "{with_square} vs {open}");
     assert!((with_square - with_net).abs() <= 1e-6 * with_square, "{with_square} vs {with_net}");
+}
+
+/// An enclosure with a modelling gap is reported on every row it affects: the cube with its
+/// ceiling lifted by half a side (a leak), and with its ceiling facing out (mis-oriented); the
+/// complete cube is not.
+#[test]
+fn enclosure_gaps_are_reported() {
+    let leaky = CUBE.replace(
+        "origin = [0, 0, 1]\nedge_t = [0, 1, 0]\nedge_s = [1, 0, 0]",
+        "origin = [0, 0, 1.5]\nedge_t = [0, 1, 0]\nedge_s = [1, 0, 0]",
+    );
+    let flipped = CUBE.replace("edge_s = [1, 0, 0]       # -z", "edge_s = [1, 0, 0]       # -z\nside = \"back\"");
+    assert_ne!(leaky, CUBE);
+    assert_ne!(flipped, CUBE);
+    for (text, gaps) in [(CUBE.to_string(), 0), (leaky, 6), (flipped, 6)] {
+        let r = run(&scene(&text), PairMethod::Tolerance(1e-8));
+        let found = &r.diagnostics.enclosure_gaps;
+        assert_eq!(found.len(), gaps, "{found:?}");
+        assert!(found.iter().all(|g| g.contains("row sum")), "{found:?}");
+    }
+}
+
+/// f32 runs the same scenes to single precision.
+#[test]
+fn single_precision_matches_to_its_resolution() {
+    let s = scene(CUBE);
+    let result = compute::<f32>(&s, PairMethod::Order { order: 8, singular_order: 8 }, None, 0, &|_| {}).unwrap();
+    let r = assemble(&s, &result, PairMethod::Order { order: 8, singular_order: 8 });
+    let opposite = closed_form::parallel_rectangles(1.0, 1.0, 1.0); // C-11
+    let adjacent = closed_form::perpendicular_rectangles(1.0, 1.0, 1.0); // C-14
+    assert!((factor(&r, "floor", "ceiling") - opposite).abs() < 1e-6);
+    assert!((factor(&r, "floor", "west") - adjacent).abs() < 1e-6);
 }

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::Args;
-use pdm_host::scene::{self, matrix::MatrixError, matrix::PairMethod, report};
+use pdm_host::scene::{self, matrix::MatrixError, matrix::PairMethod, matrix::Shard, report};
 
 use super::{parse_order, parse_threads, parse_tolerance, EXIT_FAILURE, EXIT_USAGE};
 
@@ -40,14 +40,106 @@ pub struct MatrixArgs {
     /// (names, areas, both matrices, error estimates, diagnostics). Written atomically.
     #[arg(long, value_name = "FILE")]
     pub output: Option<PathBuf>,
+    /// Compute only slice K of N of the pairs (1 <= K <= N), for running the slices as a job
+    /// array; needs --output FILE.json; join them with `pdm-ff merge`.
+    #[arg(long, value_name = "K/N", value_parser = parse_shard, requires = "output")]
+    pub shard: Option<Shard>,
     /// Worker threads (0: all cores).
     #[arg(long, value_name = "N", default_value = "0", value_parser = parse_threads, allow_negative_numbers = true)]
     pub threads: usize,
 }
 
+fn parse_shard(s: &str) -> Result<Shard, String> {
+    let Some((k, n)) = s.trim().split_once('/') else { return Err("expected K/N, e.g. 3/8".into()) };
+    let n = super::parse_count(n, 1, 1_000_000, "N")?;
+    let k = super::parse_count(k, 1, n, "K")?;
+    Ok(Shard { index: k - 1, count: n })
+}
+
+/// `pdm-ff merge`.
+#[derive(Args, Debug)]
+pub struct MergeArgs {
+    /// The slice files written by `pdm-ff matrix --shard K/N --output FILE.json`, all N of them.
+    #[arg(required = true)]
+    pub slices: Vec<PathBuf>,
+    /// Write the joined matrices (.csv or .json), as `pdm-ff matrix --output` does.
+    #[arg(long, value_name = "FILE")]
+    pub output: Option<PathBuf>,
+}
+
+fn output_format_ok(out: &std::path::Path) -> bool {
+    matches!(out.extension().and_then(|e| e.to_str()), Some("csv" | "json"))
+}
+
+fn write_report(report: &report::SceneReport, out: &std::path::Path) -> ExitCode {
+    let written =
+        report::encode(report, out).and_then(|bytes| report::write_atomic(out, &bytes).map_err(|e| e.to_string()));
+    if let Err(e) = written {
+        eprintln!("error: --output {}: {e}", out.display());
+        return ExitCode::from(EXIT_FAILURE);
+    }
+    eprintln!("wrote {}", out.display());
+    ExitCode::SUCCESS
+}
+
+/// Runs `merge`.
+pub fn run_merge(args: &MergeArgs) -> ExitCode {
+    if let Some(out) = &args.output {
+        if !output_format_ok(out) {
+            eprintln!("error: --output {}: unknown format (use a .csv or .json file name)", out.display());
+            return ExitCode::from(EXIT_USAGE);
+        }
+    }
+    let mut slices = Vec::new();
+    for path in &args.slices {
+        let read = std::fs::read(path).map_err(|e| e.to_string()).and_then(|bytes| {
+            serde_json::from_slice::<scene::SliceFile>(&bytes).map_err(|e| format!("not a slice file: {e}"))
+        });
+        match read {
+            Ok(s) => slices.push(s),
+            Err(e) => {
+                eprintln!("error: {}: {e}", path.display());
+                return ExitCode::from(EXIT_USAGE);
+            }
+        }
+    }
+    let (Some(first), Some(first_path)) = (slices.first().cloned(), args.slices.first()) else {
+        return ExitCode::from(EXIT_USAGE);
+    };
+    if let Some((path, _)) = args
+        .slices
+        .iter()
+        .zip(&slices)
+        .find(|(_, s)| s.scene != first.scene || s.method != first.method || s.precision != first.precision)
+    {
+        eprintln!("error: {}: another scene, method or precision than {}", path.display(), first_path.display());
+        return ExitCode::from(EXIT_USAGE);
+    }
+    let scene = match scene::build(&first.scene) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("error: {}: the scene in it does not build: {}", first_path.display(), e.message);
+            return ExitCode::from(EXIT_USAGE);
+        }
+    };
+    let merged = match scene::matrix::merge(slices.into_iter().map(|s| s.result).collect()) {
+        Ok(m) => m,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(EXIT_USAGE);
+        }
+    };
+    let report = report::assemble(&scene, &merged, first.method);
+    print!("{}", report::text(&report));
+    match &args.output {
+        Some(out) => write_report(&report, out),
+        None => ExitCode::SUCCESS,
+    }
+}
+
 /// Runs the command.
 pub fn run(args: &MatrixArgs) -> ExitCode {
-    let scene = match scene::load(&args.scene) {
+    let (model, scene) = match scene::load_model(&args.scene) {
         Ok(s) => s,
         Err(e) => {
             eprintln!("error: {e}");
@@ -55,8 +147,12 @@ pub fn run(args: &MatrixArgs) -> ExitCode {
         }
     };
     if let Some(out) = &args.output {
-        if !matches!(out.extension().and_then(|e| e.to_str()), Some("csv" | "json")) {
+        if !output_format_ok(out) {
             eprintln!("error: --output {}: unknown format (use a .csv or .json file name)", out.display());
+            return ExitCode::from(EXIT_USAGE);
+        }
+        if args.shard.is_some() && out.extension().and_then(|e| e.to_str()) != Some("json") {
+            eprintln!("error: --output {}: a slice (--shard) is written as .json", out.display());
             return ExitCode::from(EXIT_USAGE);
         }
     }
@@ -68,8 +164,8 @@ pub fn run(args: &MatrixArgs) -> ExitCode {
     let bar = super::progress::Bar::with_units(n * (n + 1) / 2, "pairs");
     let progress = |k: u64| bar.set_position(k);
     let result = match args.precision {
-        Precision::F32 => scene::matrix::compute::<f32>(&scene, method, args.threads, &progress),
-        Precision::F64 => scene::matrix::compute::<f64>(&scene, method, args.threads, &progress),
+        Precision::F32 => scene::matrix::compute::<f32>(&scene, method, args.shard, args.threads, &progress),
+        Precision::F64 => scene::matrix::compute::<f64>(&scene, method, args.shard, args.threads, &progress),
     };
     bar.finish();
     let result = match result {
@@ -89,16 +185,35 @@ pub fn run(args: &MatrixArgs) -> ExitCode {
             return ExitCode::from(EXIT_FAILURE);
         }
     };
-    let report = report::assemble(&scene, &result, method);
-    print!("{}", report::text(&report));
-    if let Some(out) = &args.output {
-        let written =
-            report::encode(&report, out).and_then(|bytes| report::write_atomic(out, &bytes).map_err(|e| e.to_string()));
+    if let (Some(shard), Some(out)) = (args.shard, &args.output) {
+        let precision = match args.precision {
+            Precision::F32 => "f32",
+            Precision::F64 => "f64",
+        };
+        let pairs = result.pairs.len();
+        let (skipped, seconds) = (result.skipped, result.seconds);
+        let slice = scene::SliceFile { scene: model, method, precision: precision.into(), result };
+        let written = serde_json::to_vec(&slice)
+            .map_err(|e| e.to_string())
+            .and_then(|bytes| report::write_atomic(out, &bytes).map_err(|e| e.to_string()));
         if let Err(e) = written {
             eprintln!("error: --output {}: {e}", out.display());
             return ExitCode::from(EXIT_FAILURE);
         }
-        eprintln!("wrote {}", out.display());
+        println!(
+            "slice {}/{} of {}: {pairs} pairs integrated, {skipped} skipped, {seconds:.2} s; wrote {} (join the {} slices with pdm-ff merge)",
+            shard.index + 1,
+            shard.count,
+            args.scene.display(),
+            out.display(),
+            shard.count
+        );
+        return ExitCode::SUCCESS;
     }
-    ExitCode::SUCCESS
+    let report = report::assemble(&scene, &result, method);
+    print!("{}", report::text(&report));
+    match &args.output {
+        Some(out) => write_report(&report, out),
+        None => ExitCode::SUCCESS,
+    }
 }

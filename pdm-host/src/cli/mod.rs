@@ -36,6 +36,8 @@ enum Command {
     /// Form factors of your own scene (a TOML or JSON file): patch and surface matrices with
     /// error estimates, row sums and diagnostics.
     Matrix(matrix::MatrixArgs),
+    /// Join the slices written by `matrix --shard K/N` into the scene's matrices.
+    Merge(matrix::MergeArgs),
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -180,6 +182,7 @@ pub fn main() -> ExitCode {
     match cli.command {
         Command::Validate(args) => run_validate(&args),
         Command::Matrix(args) => matrix::run(&args),
+        Command::Merge(args) => matrix::run_merge(&args),
         Command::Tradeoff(args) => match pdm_host::tradeoff::run(&args) {
             Ok(()) => ExitCode::SUCCESS,
             Err(e) => {

@@ -15,7 +15,7 @@ use super::shape::{occluder_of, Geom, Plane, Shape};
 use crate::validate::stack;
 
 /// How each pair is integrated.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum PairMethod {
     /// The tolerance mode (`adaptive_exchange`): per-pair relative tolerance, with an error
     /// estimate for every entry.
@@ -45,7 +45,7 @@ impl PairMethod {
 }
 
 /// One computed unordered pair (i ≤ j): E = A_i·F_ij = A_j·F_ji.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PairValue {
     /// First patch.
     pub i: usize,
@@ -65,8 +65,26 @@ pub struct PairValue {
     pub occluders: usize,
 }
 
+/// One slice of the unordered pairs: those whose position in the list (i ≤ j, row by row) is
+/// `index` modulo `count` (round robin, so that slices of one scene take similar times).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct Shard {
+    /// 0-based slice number, below `count`.
+    pub index: usize,
+    /// Number of slices.
+    pub count: usize,
+}
+
+impl Shard {
+    /// Whether the pair at `position` belongs to this slice.
+    #[must_use]
+    pub fn holds(&self, position: usize) -> bool {
+        position % self.count.max(1) == self.index
+    }
+}
+
 /// The result of [`compute`].
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct MatrixResult {
     /// Patch areas (the kernel's Gauss area at order 16).
     pub areas: Vec<f64>,
@@ -74,8 +92,10 @@ pub struct MatrixResult {
     pub pairs: Vec<PairValue>,
     /// Unordered pairs skipped without a kernel call (back to back, or on one convex surface).
     pub skipped: usize,
-    /// Wall time of the whole computation (s).
+    /// Wall time of the whole computation (s; for merged slices, the sum of theirs).
     pub seconds: f64,
+    /// The slice of the pairs computed (`None`: all).
+    pub shard: Option<Shard>,
 }
 
 /// A failure of one pair, with the patches named (`i == j` for a patch on its own).
@@ -311,17 +331,20 @@ impl<T: Real> Context<'_, T> {
     }
 }
 
-/// Computes every unordered pair of the scene in precision `T` with `threads` workers (0: all
-/// cores); `progress` is called with the number of pairs done so far.
+/// Computes every unordered pair of the scene (or of one `shard` of them) in precision `T`
+/// with `threads` workers (0: all cores); `progress` is called with the number of pairs done so
+/// far.
 pub fn compute<T: Real>(
     scene: &Scene,
     method: PairMethod,
+    shard: Option<Shard>,
     threads: usize,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<MatrixResult, MatrixError> {
     struct Job<'a, T> {
         scene: &'a Scene,
         method: PairMethod,
+        shard: Option<Shard>,
         threads: usize,
         progress: &'a (dyn Fn(u64) + Sync),
         precision: std::marker::PhantomData<T>,
@@ -329,16 +352,17 @@ pub fn compute<T: Real>(
     impl<T: Real> WithCapacity for Job<'_, T> {
         type Output = Result<MatrixResult, MatrixError>;
         fn run<const CAP: usize>(self) -> Self::Output {
-            compute_with::<T, CAP>(self.scene, self.method, self.threads, self.progress)
+            compute_with::<T, CAP>(self.scene, self.method, self.shard, self.threads, self.progress)
         }
     }
-    let job = Job::<T> { scene, method, threads, progress, precision: std::marker::PhantomData };
+    let job = Job::<T> { scene, method, shard, threads, progress, precision: std::marker::PhantomData };
     pdm_kernel::with_capacity(method.capacity(), job).map_err(|error| MatrixError::Threads(error.to_string()))?
 }
 
 fn compute_with<T: Real, const CAP: usize>(
     scene: &Scene,
     method: PairMethod,
+    shard: Option<Shard>,
     threads: usize,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<MatrixResult, MatrixError> {
@@ -370,7 +394,12 @@ fn compute_with<T: Real, const CAP: usize>(
     ctx.info = info;
 
     let n = scene.patches.len();
-    let pairs: Vec<(usize, usize)> = (0..n).flat_map(|i| (i..n).map(move |j| (i, j))).collect();
+    let pairs: Vec<(usize, usize)> = (0..n)
+        .flat_map(|i| (i..n).map(move |j| (i, j)))
+        .enumerate()
+        .filter(|(position, _)| shard.is_none_or(|s| s.holds(*position)))
+        .map(|(_, pair)| pair)
+        .collect();
     let done = std::sync::atomic::AtomicU64::new(0);
     let pool = stack::pool::<T>(threads, CAP).map_err(MatrixError::Threads)?;
     let results: Vec<Result<Option<PairValue>, PairError>> = pool.install(|| {
@@ -399,5 +428,42 @@ fn compute_with<T: Real, const CAP: usize>(
         pairs: out,
         skipped,
         seconds: start.elapsed().as_secs_f64(),
+        shard,
     })
+}
+
+/// Joins the results of slices `0..count` of one scene, each present once: the result of
+/// computing the whole scene at once, pairs in the same order (so the matrices are the same to
+/// the bit). `Err` names what is missing or repeated.
+pub fn merge(parts: Vec<MatrixResult>) -> Result<MatrixResult, String> {
+    let Some(first) = parts.first() else { return Err("no slices to merge".into()) };
+    let count = first.shard.map_or(1, |s| s.count);
+    let mut seen = vec![false; count];
+    for p in &parts {
+        let Some(s) = p.shard else { return Err("a file holds a whole scene, not a slice (--shard)".into()) };
+        if s.count != count {
+            return Err(format!("slice {}/{} does not belong with slices of {count}", s.index + 1, s.count));
+        }
+        if p.areas != first.areas {
+            return Err(format!("slice {}/{count} has other patch areas: another scene or precision", s.index + 1));
+        }
+        match seen.get_mut(s.index) {
+            Some(flag) if !*flag => *flag = true,
+            Some(_) => return Err(format!("slice {}/{count} is given twice", s.index + 1)),
+            None => return Err(format!("slice {}/{count} is out of range", s.index + 1)),
+        }
+    }
+    if let Some(missing) = seen.iter().position(|&s| !s) {
+        return Err(format!("slice {}/{count} is missing", missing + 1));
+    }
+    let areas = first.areas.clone();
+    let mut merged = MatrixResult { areas, pairs: Vec::new(), skipped: 0, seconds: 0.0, shard: None };
+    for p in parts {
+        merged.pairs.extend(p.pairs);
+        merged.skipped += p.skipped;
+        merged.seconds += p.seconds;
+    }
+    // The whole run's order (row by row), so that the sums come out the same to the bit.
+    merged.pairs.sort_by_key(|p| (p.i, p.j));
+    Ok(merged)
 }

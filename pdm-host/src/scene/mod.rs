@@ -1,5 +1,5 @@
 //! Scenes: the user's own geometry from a file (TOML or JSON, one model: [`model`]), built into
-//! surfaces and patches ([`build`]), the form-factor matrices computed pair by pair
+//! surfaces and patches ([`mod@build`]), the form-factor matrices computed pair by pair
 //! ([`matrix`]) and reported with their diagnostics ([`report`]). The file format is described
 //! field by field in `SCENES.md`.
 // Patch, surface and piece indices are made by `build` from the scene's own vectors (and the
@@ -115,11 +115,33 @@ pub fn from_text(text: &str, format: Format, file: &str) -> Result<Scene, SceneE
 
 /// Reads, parses and builds a scene file.
 pub fn load(path: &Path) -> Result<Scene, SceneError> {
+    load_model(path).map(|(_, scene)| scene)
+}
+
+/// Reads, parses and builds a scene file; the model as read, and the scene.
+pub fn load_model(path: &Path) -> Result<(SceneFile, Scene), SceneError> {
     let file = path.display().to_string();
     let text = std::fs::read_to_string(path).map_err(|e| SceneError {
         file: file.clone(),
         line: None,
         message: format!("cannot read: {e}"),
     })?;
-    from_text(&text, Format::of(path), &file)
+    let format = Format::of(path);
+    let model = parse(&text, format, &file)?;
+    let scene = from_text(&text, format, &file)?;
+    Ok((model, scene))
+}
+
+/// What `pdm-ff matrix --shard K/N` writes: the scene it belongs to (as read), how its pairs
+/// were integrated, and its slice of them; `pdm-ff merge` joins the N slices.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SliceFile {
+    /// The scene model.
+    pub scene: SceneFile,
+    /// The pair method.
+    pub method: matrix::PairMethod,
+    /// `f32` or `f64`.
+    pub precision: String,
+    /// The slice's pairs.
+    pub result: matrix::MatrixResult,
 }

@@ -18,11 +18,11 @@ pub struct Matrix {
     pub names: Vec<String>,
     /// Areas (unit²).
     pub areas: Vec<f64>,
-    /// F[i][j]: the fraction of what leaves i that arrives at j.
+    /// `F[i][j]`: the fraction of what leaves i that arrives at j.
     pub factors: Vec<Vec<f64>>,
-    /// Estimated absolute error of each F[i][j].
+    /// Estimated absolute error of each `F[i][j]`.
     pub errors: Option<Vec<Vec<f64>>>,
-    /// Σ_j F[i][j].
+    /// `Σ_j F[i][j]`.
     pub row_sums: Vec<f64>,
 }
 
