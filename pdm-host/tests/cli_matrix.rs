@@ -90,7 +90,8 @@ fn slices_merge_into_the_whole() {
     args.extend(["--output", merged.to_str().unwrap()]);
     let out = pdm(&args);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let read = |p: &std::path::Path| -> serde_json::Value { serde_json::from_slice(&std::fs::read(p).unwrap()).unwrap() };
+    let read =
+        |p: &std::path::Path| -> serde_json::Value { serde_json::from_slice(&std::fs::read(p).unwrap()).unwrap() };
     let (a, b) = (read(&whole), read(&merged));
     assert_eq!(a["surfaces"]["factors"], b["surfaces"]["factors"]);
     assert_eq!(a["patches"]["factors"], b["patches"]["factors"]);

@@ -133,15 +133,25 @@ impl<T: Real> Probe<T> {
             return false;
         }
         if level >= MAX_LEVELS || flatness(net) <= self.flat {
-            // An end point on this small, nearly flat piece: the segment starts (or ends) on
-            // the surface here and does not cross it again within the piece (its corner
-            // triangles lie off the surface by up to the flatness, which a segment leaving at a
-            // shallow angle would cross).
+            // An end point on this nearly flat piece (within its ball and twice the flatness of
+            // its plane): the segment starts (or ends) on the surface here and does not cross
+            // it again within the piece (its corner triangles lie off the surface by up to the
+            // flatness, which a segment leaving at a shallow angle would cross).
+            let (p00, p30, p03, p33) = (net[0][0], net[3][0], net[0][3], net[3][3]);
+            // The piece's plane: through its corners' centroid, normal to the diagonals (also for
+            // a corner collapsed to a point, a triangle).
+            let normal = (p33 - p00).cross(p03 - p30);
+            let length = normal.norm();
+            let centre = (p00 + p30 + p03 + p33).scale(T::from_f64(0.25));
             let reach = r + self.flat;
-            if (self.p - c).norm() <= reach || (self.q - c).norm() <= reach {
+            let on_piece = |x: Vec3<T>| {
+                (x - c).norm() <= reach
+                    && (length > T::ZERO)
+                    && (normal.dot(x - centre) / length).abs() <= T::TWO * self.flat
+            };
+            if on_piece(self.p) || on_piece(self.q) {
                 return false;
             }
-            let (p00, p30, p03, p33) = (net[0][0], net[3][0], net[0][3], net[3][3]);
             let first = triangle_crossing(self.p, self.d, p00, p30, p33).is_some_and(|t| self.accept(t));
             return first || triangle_crossing(self.p, self.d, p00, p33, p03).is_some_and(|t| self.accept(t));
         }

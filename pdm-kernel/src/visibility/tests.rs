@@ -397,3 +397,48 @@ fn bezier_chords_of_its_own_points_are_clear() {
         }
     }
 }
+
+/// A flat Bézier patch (one subdivision level: the root is already flat) blocks segments whose
+/// end points lie near it but off its plane, as the parallelogram it equals does; and a
+/// triangle (a net with one side collapsed to a point) blocks as the triangle.
+#[test]
+fn flat_bezier_blocks_near_its_plane_like_the_parallelogram() {
+    use crate::surface::BezierPatch;
+    let (o_, et, es) = (vec3(0.0, 0.0, 0.0), vec3(2.0, 0.0, 0.0), vec3(0.0, 2.0, 0.0));
+    let square = Parallelogram::new(o_, et, es).unwrap();
+    let mut net = [[o(); 4]; 4];
+    let mut tri = [[o(); 4]; 4];
+    let (a, b, c) = (vec3(0.0, 0.0, 0.0), vec3(2.0, 0.0, 0.0), vec3(0.0, 2.0, 0.0));
+    for (i, (row, trow)) in net.iter_mut().zip(tri.iter_mut()).enumerate() {
+        for (j, (p, tp)) in row.iter_mut().zip(trow.iter_mut()).enumerate() {
+            let (u, v) = (i as f64 / 3.0, j as f64 / 3.0);
+            *p = o_ + et.scale(u) + es.scale(v);
+            *tp = a + (b - a + (c - b).scale(v)).scale(u);
+        }
+    }
+    let flat = BezierPatch::new(net).unwrap();
+    let triangle = BezierPatch::new(tri).unwrap();
+    let mut state = 99u64;
+    let mut next = || {
+        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((state >> 11) as f64 / (1u64 << 53) as f64) * 3.0 - 0.5
+    };
+    let (mut hits, mut tri_hits) = (0, 0);
+    for _ in 0..2000 {
+        // End points within the patch's ball, a little off its plane on either side.
+        let p = vec3(next(), next(), 0.05 + 0.3 * next().abs());
+        let q = vec3(next(), next(), -0.05 - 0.3 * next().abs());
+        assert_eq!(flat.blocks(p, q), square.blocks(p, q), "{p:?} -> {q:?}");
+        let d = q - p;
+        let tau = -p.z / d.z;
+        let x = p + d.scale(tau);
+        let inside = x.x > 1e-9 && x.y > 1e-9 && x.x + x.y < 2.0 - 1e-9;
+        let edge = x.x.abs() < 1e-6 || x.y.abs() < 1e-6 || (x.x + x.y - 2.0).abs() < 1e-6;
+        if !edge {
+            assert_eq!(triangle.blocks(p, q), inside, "{p:?} -> {q:?}");
+        }
+        hits += usize::from(square.blocks(p, q));
+        tri_hits += usize::from(inside);
+    }
+    assert!(hits > 300 && tri_hits > 100 && tri_hits < hits, "{hits} {tri_hits}");
+}
