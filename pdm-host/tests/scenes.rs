@@ -337,3 +337,47 @@ fn single_precision_matches_to_its_resolution() {
     assert!((factor(&r, "floor", "ceiling") - opposite).abs() < 1e-6);
     assert!((factor(&r, "floor", "west") - adjacent).abs() < 1e-6);
 }
+
+/// The unit cube from an OBJ file (one object per face, 12 triangles) against C-11 and C-14:
+/// opposite faces exact; adjacent faces whose triangles meet at their collapsed corners
+/// converge slowly in the touching transforms, and there the estimate must cover the error.
+#[test]
+fn obj_cube_against_c11_and_c14() {
+    let path = format!("{}/../examples/scenes/cube_obj.toml", env!("CARGO_MANIFEST_DIR"));
+    let s = pdm_host::scene::load(std::path::Path::new(&path)).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(s.surfaces.len(), 6);
+    assert_eq!(s.patches.len(), 12);
+    let r = run(&s, PairMethod::Tolerance(1e-8));
+    let opposite = closed_form::parallel_rectangles(1.0, 1.0, 1.0); // C-11
+    let adjacent = closed_form::perpendicular_rectangles(1.0, 1.0, 1.0); // C-14
+    check(&r, "cube/floor", "cube/ceiling", opposite, 1e-9);
+    check(&r, "cube/west", "cube/east", opposite, 1e-9);
+    for (a, b) in [("cube/floor", "cube/south"), ("cube/floor", "cube/north"), ("cube/west", "cube/north")] {
+        check(&r, a, b, adjacent, 1e-4);
+    }
+    for (i, sum) in r.surfaces.row_sums.iter().enumerate() {
+        let allowed: f64 = r.surfaces.errors.as_ref().unwrap()[i].iter().sum();
+        assert!((sum - 1.0).abs() <= allowed, "row {i}: {sum} beyond {allowed:e}");
+    }
+}
+
+/// An STL file (ASCII; two triangles making a 2 × 2 square, facing up) under a parallel
+/// rectangle: C-11. Facets radiate to the counter-clockwise side.
+#[test]
+fn stl_square_under_a_rectangle() {
+    let dir = tempfile::tempdir().unwrap();
+    let stl = "solid sq\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 2 0 0\nvertex 2 2 0\nendloop\nendfacet\n\
+               facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 2 2 0\nvertex 0 2 0\nendloop\nendfacet\nendsolid sq\n";
+    std::fs::write(dir.path().join("sq.stl"), stl).unwrap();
+    let scene_text = "[[surface]]\nname = \"square\"\nkind = \"mesh\"\nfile = \"sq.stl\"\n\n\
+                      [[surface]]\nname = \"top\"\nkind = \"rectangle\"\norigin = [0, 0, 1]\nedge_t = [0, 2, 0]\nedge_s = [2, 0, 0]\n";
+    let path = dir.path().join("scene.toml");
+    std::fs::write(&path, scene_text).unwrap();
+    let s = pdm_host::scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    let r = run(&s, PairMethod::Tolerance(1e-9));
+    check(&r, "square", "top", closed_form::parallel_rectangles(2.0, 2.0, 1.0), 1e-9); // C-11
+                                                                                       // A missing mesh file is a named error.
+    std::fs::remove_file(dir.path().join("sq.stl")).unwrap();
+    let e = pdm_host::scene::load(&path).unwrap_err().to_string();
+    assert!(e.contains("surface #1 'square': field `file`") && e.contains("sq.stl"), "{e}");
+}

@@ -1,6 +1,8 @@
 //! From the file's model to the scene's geometry: placement, sides, pieces and patches, every
 //! value checked with an error that names the surface and the field.
 
+use std::path::Path;
+
 use pdm_kernel::{vec3, Frame, ParamRect, Vec3};
 
 use super::model::{fields_of, Kind, SceneFile, SideSpec, SurfaceSpec};
@@ -22,6 +24,9 @@ pub struct SceneSurface {
     /// Index of the file's entry: the two sides of one entry share it (one geometry, one
     /// occluder).
     pub entry: usize,
+    /// The group within the entry (a mesh file's object; 0 otherwise): the two sides of one
+    /// group are the two surfaces with the same entry and group.
+    pub group: usize,
     /// Whether it blocks the view between other surfaces.
     pub occludes: bool,
     /// Its pieces: one kernel surface each (several for a Bézier net), with the parameter range
@@ -182,14 +187,14 @@ fn placed_frame(frame: Frame<f64>, place: &Place) -> Frame<f64> {
 }
 
 /// The geometry of one side of an entry: `back` (sheets) or `inner` (closed kinds) flips it.
-fn geometry(i: usize, spec: &SurfaceSpec, flip: bool, place: &Place) -> Result<Vec<(Geom, Rect)>, EntryError> {
+fn geometry(i: usize, spec: &SurfaceSpec, flip: bool, place: &Place, base: &Path) -> Result<Groups, EntryError> {
     let (required, optional) = fields_of(spec.kind);
     for field in spec.geometry_fields() {
         if !required.contains(&field) && !optional.contains(&field) {
             return fail(i, spec, field, format!("does not belong to kind {}", spec.kind.name()));
         }
     }
-    let full = |g: Geom| Ok(vec![(g, g.domain())]);
+    let full = |g: Geom| Ok(vec![(String::new(), vec![(g, g.domain())])]);
     match spec.kind {
         Kind::Rectangle => {
             let origin = place.point(vector(i, spec, "origin", spec.origin)?);
@@ -214,7 +219,7 @@ fn geometry(i: usize, spec: &SurfaceSpec, flip: bool, place: &Place) -> Result<V
             let frame = direction(i, spec, "normal", if flip { -axis } else { axis })?;
             let (a, b) = angles(i, spec, "theta", spec.theta, 360.0)?;
             let g = Geom::Disk { center, frame, inner, outer };
-            Ok(vec![(g, ParamRect { t0: inner, t1: outer, s0: a, s1: b })])
+            Ok(vec![(String::new(), vec![(g, ParamRect { t0: inner, t1: outer, s0: a, s1: b })])])
         }
         Kind::Sphere => {
             let center = place.point(vector(i, spec, "center", spec.center)?);
@@ -228,7 +233,7 @@ fn geometry(i: usize, spec: &SurfaceSpec, flip: bool, place: &Place) -> Result<V
             let (p0, p1) = angles(i, spec, "phi", spec.phi, 180.0)?;
             let (a, b) = angles(i, spec, "theta", spec.theta, 360.0)?;
             let g = Geom::Sphere { center, radius, frame, inner: flip };
-            Ok(vec![(g, ParamRect { t0: p0, t1: p1, s0: a, s1: b })])
+            Ok(vec![(String::new(), vec![(g, ParamRect { t0: p0, t1: p1, s0: a, s1: b })])])
         }
         Kind::Cylinder | Kind::Cone => {
             let base = place.point(vector(i, spec, "base", spec.base)?);
@@ -254,7 +259,7 @@ fn geometry(i: usize, spec: &SurfaceSpec, flip: bool, place: &Place) -> Result<V
                 }
                 Geom::Cone { base, frame, base_radius, top_radius, height, inner: flip }
             };
-            Ok(vec![(g, ParamRect { t0: a, t1: b, s0: 0.0, s1: height })])
+            Ok(vec![(String::new(), vec![(g, ParamRect { t0: a, t1: b, s0: 0.0, s1: height })])])
         }
         Kind::Bezier => {
             let Some(net) = &spec.control else { return fail(i, spec, "control", "missing (kind bezier needs it)") };
@@ -289,9 +294,64 @@ fn geometry(i: usize, spec: &SurfaceSpec, flip: bool, place: &Place) -> Result<V
                     out.push((g, g.domain()));
                 }
             }
+            Ok(vec![(String::new(), out)])
+        }
+        Kind::Mesh => {
+            let Some(name) = &spec.file else { return fail(i, spec, "file", "missing (kind mesh needs it)") };
+            let path = base.join(name);
+            let groups = match super::mesh::load(&path) {
+                Ok(g) if g.is_empty() => return fail(i, spec, "file", format!("{}: has no facets", path.display())),
+                Ok(g) => g,
+                Err(e) => return fail(i, spec, "file", e),
+            };
+            let several = groups.len() > 1;
+            let mut out = Vec::new();
+            for (group, triangles) in groups {
+                let mut pieces = Vec::new();
+                for (k, t) in triangles.iter().enumerate() {
+                    if t.iter().any(|p| !p.is_finite()) {
+                        return fail(
+                            i,
+                            spec,
+                            "file",
+                            format!("{}: facet {} has a non-finite vertex", path.display(), k + 1),
+                        );
+                    }
+                    let area = (t[1] - t[0]).cross(t[2] - t[0]).norm();
+                    let size = (t[1] - t[0]).norm().max((t[2] - t[0]).norm());
+                    if !(area > 1e-12 * size * size) {
+                        return fail(
+                            i,
+                            spec,
+                            "file",
+                            format!("{}: facet {} ({group}) has zero area", path.display(), k + 1),
+                        );
+                    }
+                    let mut control = super::mesh::triangle_net(t).map(|row| row.map(|p| place.point(p)));
+                    if flip {
+                        control = transpose(&control);
+                    }
+                    let g = Geom::Bezier { control };
+                    pieces.push((g, g.domain()));
+                }
+                out.push((if several { format!("/{group}") } else { String::new() }, pieces));
+            }
             Ok(out)
         }
     }
+}
+
+/// Pieces of one entry's side by group (a mesh file's objects; one unnamed group otherwise).
+type Groups = Vec<(String, Vec<(Geom, Rect)>)>;
+
+fn transpose(n: &[[Vec3<f64>; 4]; 4]) -> [[Vec3<f64>; 4]; 4] {
+    let mut t = *n;
+    for (i, row) in n.iter().enumerate() {
+        for (j, &p) in row.iter().enumerate() {
+            t[j][i] = p;
+        }
+    }
+    t
 }
 
 /// Arc length of the parameter line through the middle of `rect` along t (`along_t`) or s.
@@ -310,8 +370,14 @@ fn mid_length(geom: &Geom, rect: Rect, along_t: bool) -> f64 {
     (0..SEGMENTS).map(|k| (at((k + 1) as f64 / SEGMENTS as f64) - at(k as f64 / SEGMENTS as f64)).norm()).sum()
 }
 
-/// Builds the scene: checks every entry, places it, splits two-sided entries, subdivides.
+/// Builds the scene: checks every entry, places it, splits two-sided entries, subdivides; mesh
+/// files are looked up in the current folder.
 pub fn build(file: &SceneFile) -> Result<Scene, EntryError> {
+    build_in(file, Path::new("."))
+}
+
+/// [`build`], with mesh files looked up relative to `base` (the scene file's folder).
+pub fn build_in(file: &SceneFile, base: &Path) -> Result<Scene, EntryError> {
     if file.surfaces.is_empty() {
         return Err(EntryError {
             entry: 0,
@@ -372,54 +438,58 @@ pub fn build(file: &SceneFile) -> Result<Scene, EntryError> {
             }
         }
         for (flip, suffix) in sides {
-            let mut pieces = Vec::new();
-            for (geom, rect) in geometry(i, spec, flip, &place)? {
-                let grid = match (spec.subdivide, spec.patch_size) {
-                    // A flipped Bézier net is transposed: its grid too, so that its cells are
-                    // the front's.
-                    (Some([m, n]), _) if flip && spec.kind == Kind::Bezier => (n, m),
-                    (Some([m, n]), _) => (m, n),
-                    (None, Some(size)) => {
-                        let count = |along_t| (mid_length(&geom, rect, along_t) / size).ceil().max(1.0);
-                        let (m, n) = (count(true), count(false));
-                        if m > MAX_SUBDIVISION as f64 || n > MAX_SUBDIVISION as f64 {
-                            return fail(
+            for (group, (group_name, list)) in geometry(i, spec, flip, &place, base)?.into_iter().enumerate() {
+                let mut pieces = Vec::new();
+                for (geom, rect) in list {
+                    let grid =
+                        match (spec.subdivide, spec.patch_size) {
+                            // A flipped Bézier net is transposed: its grid too, so that its cells are
+                            // the front's.
+                            (Some([m, n]), _) if flip && matches!(spec.kind, Kind::Bezier | Kind::Mesh) => (n, m),
+                            (Some([m, n]), _) => (m, n),
+                            (None, Some(size)) => {
+                                let count = |along_t| (mid_length(&geom, rect, along_t) / size).ceil().max(1.0);
+                                let (m, n) = (count(true), count(false));
+                                if m > MAX_SUBDIVISION as f64 || n > MAX_SUBDIVISION as f64 {
+                                    return fail(
                                 i,
                                 spec,
                                 "patch_size",
                                 format!("{size} gives {m} x {n} patches per piece, more than {MAX_SUBDIVISION} a side"),
                             );
-                        }
-                        (m as usize, n as usize)
+                                }
+                                (m as usize, n as usize)
+                            }
+                            (None, None) => (1, 1),
+                        };
+                    // The kernel's own checks (a zero-area Bézier net is found when sampled).
+                    if let Err(e) = geom.shape::<f64>() {
+                        return fail(i, spec, "", format!("the kernel rejects the geometry: {e}"));
                     }
-                    (None, None) => (1, 1),
-                };
-                // The kernel's own checks (a zero-area Bézier net is found when sampled).
-                if let Err(e) = geom.shape::<f64>() {
-                    return fail(i, spec, "", format!("the kernel rejects the geometry: {e}"));
+                    pieces.push(Piece { geom, rect, grid });
                 }
-                pieces.push(Piece { geom, rect, grid });
-            }
-            let occludes = spec.occludes.unwrap_or(true);
-            if occludes && !pieces.iter().all(|p| p.rect == p.geom.domain()) {
-                return fail(
-                    i,
-                    spec,
-                    "occludes",
-                    format!(
-                        "is true (the default), but pdm has no occluder for a part of a {} (a `theta` or `phi` \
+                let occludes = spec.occludes.unwrap_or(true);
+                if occludes && !pieces.iter().all(|p| p.rect == p.geom.domain()) {
+                    return fail(
+                        i,
+                        spec,
+                        "occludes",
+                        format!(
+                            "is true (the default), but pdm has no occluder for a part of a {} (a `theta` or `phi` \
                          range); set `occludes = false` (exact only if it hides nothing between other surfaces)",
-                        spec.kind.name()
-                    ),
-                );
+                            spec.kind.name()
+                        ),
+                    );
+                }
+                surfaces.push(SceneSurface {
+                    name: format!("{}{group_name}{suffix}", spec.name),
+                    kind: spec.kind,
+                    entry: i,
+                    group,
+                    occludes,
+                    pieces,
+                });
             }
-            surfaces.push(SceneSurface {
-                name: format!("{}{suffix}", spec.name),
-                kind: spec.kind,
-                entry: i,
-                occludes,
-                pieces,
-            });
         }
     }
     let mut patches = Vec::new();

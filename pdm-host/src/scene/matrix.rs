@@ -11,6 +11,7 @@ use pdm_kernel::{
 use rayon::prelude::*;
 
 use super::build::{Scene, ScenePatch};
+use super::model::Kind;
 use super::shape::{occluder_of, Geom, Plane, Shape};
 use crate::validate::stack;
 
@@ -240,7 +241,7 @@ impl<T: Real> Context<'_, T> {
         // does not face. A Bézier sheet is taken to be such a part of a convex surface (a dish,
         // a curved panel); a wavy sheet whose front sees its own back is not supported
         // (SCENES.md).
-        if si.entry == sj.entry && pi.surface != pj.surface {
+        if si.entry == sj.entry && si.group == sj.group && pi.surface != pj.surface {
             return Plan::Skip;
         }
         if self.behind(i, j) || self.behind(j, i) {
@@ -252,12 +253,17 @@ impl<T: Real> Context<'_, T> {
             if self.occluders[k].is_empty() {
                 continue;
             }
-            // The two sides of one entry are one occluder: take it once.
-            if scene.surfaces[..k].iter().enumerate().any(|(m, o)| o.entry == s.entry && !self.occluders[m].is_empty())
+            // The two sides of one entry (or mesh group) are one occluder: take it once.
+            if scene.surfaces[..k]
+                .iter()
+                .enumerate()
+                .any(|(m, o)| o.entry == s.entry && o.group == s.group && !self.occluders[m].is_empty())
             {
                 continue;
             }
-            if s.entry == si.entry || s.entry == sj.entry {
+            // A mesh's facets are occluders one by one: a pair's own facets are left out by the
+            // plane test below, like any flat occluder with both patches on one side.
+            if (s.entry == si.entry || s.entry == sj.entry) && s.kind != Kind::Mesh {
                 // A segment between two points of one surface is a chord of its solid (a Bézier
                 // sheet is taken to be part of a convex surface, SCENES.md); a flat sheet or a
                 // convex side never blocks a segment that starts on it and passes the facing

@@ -9,6 +9,7 @@
 
 pub mod build;
 pub mod matrix;
+pub mod mesh;
 pub mod model;
 pub mod report;
 pub mod shape;
@@ -95,7 +96,8 @@ pub fn parse(text: &str, format: Format, file: &str) -> Result<SceneFile, SceneE
 /// Parses and builds a scene text.
 pub fn from_text(text: &str, format: Format, file: &str) -> Result<Scene, SceneError> {
     let model = parse(text, format, file)?;
-    build(&model).map_err(|e| {
+    let base = Path::new(file).parent().unwrap_or(Path::new("."));
+    build::build_in(&model, base).map_err(|e| {
         let line = if format == Format::Toml { surface_line(text, e.entry) } else { None };
         let who = if e.name.is_empty() {
             format!("surface #{}", e.entry + 1)

@@ -44,6 +44,8 @@ pub enum Kind {
     Cone,
     /// Bicubic Bézier patches: a (3m + 1) × (3n + 1) control net, m × n patches sharing edges.
     Bezier,
+    /// Flat facets from a mesh file (OBJ or STL), one surface per OBJ object or group.
+    Mesh,
 }
 
 impl Kind {
@@ -57,6 +59,7 @@ impl Kind {
             Self::Cylinder => "cylinder",
             Self::Cone => "cone",
             Self::Bezier => "bezier",
+            Self::Mesh => "mesh",
         }
     }
 
@@ -172,6 +175,10 @@ pub struct SurfaceSpec {
     /// Bézier: the control net, (3m + 1) rows along t of (3n + 1) points along s.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub control: Option<Vec<Vec<[f64; 3]>>>,
+    /// Mesh: the OBJ or STL file, relative to the scene file's folder. Facets radiate to the
+    /// side their vertex order turns counter-clockwise around (`front`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub file: Option<String>,
 }
 
 impl SurfaceSpec {
@@ -199,6 +206,7 @@ impl SurfaceSpec {
         check(self.theta.is_some(), "theta");
         check(self.phi.is_some(), "phi");
         check(self.control.is_some(), "control");
+        check(self.file.is_some(), "file");
         set
     }
 }
@@ -213,5 +221,6 @@ pub fn fields_of(kind: Kind) -> (&'static [&'static str], &'static [&'static str
         Kind::Cylinder => (&["base", "axis", "radius", "height"], &["theta"]),
         Kind::Cone => (&["base", "axis", "base_radius", "top_radius", "height"], &["theta"]),
         Kind::Bezier => (&["control"], &[]),
+        Kind::Mesh => (&["file"], &[]),
     }
 }

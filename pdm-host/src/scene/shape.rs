@@ -188,6 +188,20 @@ impl Geom {
                 Some(Plane { origin, normal: n.scale(1.0 / n.norm()) })
             }
             Self::Disk { center, frame, .. } => Some(Plane { origin: center, normal: frame.axis }),
+            Self::Bezier { control } => {
+                // A flat net (a mesh facet): its control points in one plane, normal to the
+                // diagonals of the corners, on the side of ∂g/∂t × ∂g/∂s.
+                let [p00, p30, p03, p33] = [control[0][0], control[3][0], control[0][3], control[3][3]];
+                let n = (p33 - p00).cross(p03 - p30);
+                let length = n.norm();
+                let size = control.iter().flatten().map(|p| (*p - p00).norm()).fold(0.0, f64::max);
+                if !(length > 0.0) {
+                    return None;
+                }
+                let normal = n.scale(1.0 / length);
+                let flat = control.iter().flatten().all(|p| normal.dot(*p - p00).abs() <= 1e-12 * size);
+                flat.then_some(Plane { origin: p00, normal })
+            }
             _ => None,
         }
     }
@@ -221,7 +235,8 @@ impl Geom {
 
     /// Conservative bounds [min, max] of the signed distance from `plane` over the patch on
     /// `rect`: exact for parallelograms, disks, tubes and cones (closed-form extremes), the
-    /// patch's enclosing ball ([`Patch::enclosing_ball`]) for spheres and Bézier patches.
+    /// control points for a whole Bézier net (its convex hull holds it), the patch's enclosing
+    /// ball ([`Patch::enclosing_ball`]) for spheres and parts of Bézier nets.
     #[must_use]
     pub fn distance_range(&self, rect: Rect, plane: &Plane) -> (f64, f64) {
         let n = plane.normal;
@@ -262,6 +277,11 @@ impl Geom {
                     range.1 = range.1.max(c + radius * hi + g * z);
                 }
                 range
+            }
+            // The whole net: the convex hull of its control points holds the surface.
+            Self::Bezier { control } if rect == self.domain() => {
+                let d = control.iter().flatten().map(|p| plane.distance(*p));
+                d.fold((f64::MAX, -f64::MAX), |(lo, hi), x| (lo.min(x), hi.max(x)))
             }
             Self::Sphere { .. } | Self::Bezier { .. } => match self.shape::<f64>() {
                 Ok(shape) => match Patch::new(&shape, rect) {
