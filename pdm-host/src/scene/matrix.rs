@@ -12,7 +12,7 @@ use rayon::prelude::*;
 
 use super::build::{Scene, ScenePatch};
 use super::model::Kind;
-use super::shape::{occluder_of, Geom, Plane, Shape};
+use super::shape::{corners, occluder_of, Geom, Plane, Shape};
 use crate::validate::stack;
 
 /// How each pair is integrated.
@@ -144,11 +144,7 @@ fn inside_solid(solid: &Geom, geom: &Geom, p: &ScenePatch, ball: (Vec3<f64>, f64
         Geom::Sphere { center, radius, .. } => {
             let reach = match *geom {
                 Geom::Parallelogram { origin, edge_t, edge_s } => {
-                    let r = p.rect;
-                    [(r.t0, r.s0), (r.t1, r.s0), (r.t0, r.s1), (r.t1, r.s1)]
-                        .iter()
-                        .map(|&(t, s)| (origin + edge_t.scale(t) + edge_s.scale(s) - center).norm())
-                        .fold(0.0, f64::max)
+                    corners(origin, edge_t, edge_s, p.rect).map(|x| (x - center).norm()).fold(0.0, f64::max)
                 }
                 Geom::Disk { center: c, outer, .. } => (c - center).norm() + outer,
                 _ => (bc - center).norm() + br,
@@ -167,11 +163,7 @@ fn inside_solid(solid: &Geom, geom: &Geom, p: &ScenePatch, ball: (Vec3<f64>, f64
             };
             let reach = match *geom {
                 Geom::Parallelogram { origin, edge_t, edge_s } => {
-                    let r = p.rect;
-                    [(r.t0, r.s0), (r.t1, r.s0), (r.t0, r.s1), (r.t1, r.s1)]
-                        .iter()
-                        .map(|&(t, s)| radial(origin + edge_t.scale(t) + edge_s.scale(s)))
-                        .fold(0.0, f64::max)
+                    corners(origin, edge_t, edge_s, p.rect).map(radial).fold(0.0, f64::max)
                 }
                 Geom::Disk { center, outer, .. } => radial(center) + outer,
                 _ => radial(bc) + br,
@@ -191,6 +183,13 @@ struct Context<'s, T> {
     info: Vec<PatchInfo<T>>,
     balls: Vec<(Vec3<f64>, f64)>,
     planes: Vec<Option<Plane>>,
+    /// Per surface and piece: whether the radiating side may be concave, and the plane of a
+    /// flat piece (computed once: a Bézier piece's concavity is sampled).
+    piece_concave: Vec<Vec<bool>>,
+    piece_planes: Vec<Vec<Option<Plane>>>,
+    /// Per surface: whether it stands for its entry's (or mesh group's) occluder, the first of
+    /// the two sides that occludes.
+    stands: Vec<bool>,
     tol: f64,
 }
 
@@ -233,7 +232,8 @@ impl<T: Real> Context<'_, T> {
         let (gi, gj) = (scene.geom(pi), scene.geom(pj));
         // Patches of one convex side of a sphere, tube or cone, or one flat sheet, never see
         // each other (a chord of a convex solid leaves it only at its ends).
-        if si.entry == sj.entry && pi.surface == pj.surface && !gi.concave() && !matches!(gi, Geom::Bezier { .. }) {
+        let concave = |p: &ScenePatch| self.piece_concave[p.surface][p.piece];
+        if si.entry == sj.entry && pi.surface == pj.surface && !concave(pi) && !matches!(gi, Geom::Bezier { .. }) {
             return Plan::Skip;
         }
         // The two sides of one sheet or closed surface: a segment between two of its points is
@@ -250,15 +250,7 @@ impl<T: Real> Context<'_, T> {
         let (bi, bj) = (&self.info[i].ball, &self.info[j].ball);
         let mut list = Vec::new();
         for (k, s) in scene.surfaces.iter().enumerate() {
-            if self.occluders[k].is_empty() {
-                continue;
-            }
-            // The two sides of one entry (or mesh group) are one occluder: take it once.
-            if scene.surfaces[..k]
-                .iter()
-                .enumerate()
-                .any(|(m, o)| o.entry == s.entry && o.group == s.group && !self.occluders[m].is_empty())
-            {
+            if !self.stands[k] {
                 continue;
             }
             // A mesh's facets are occluders one by one: a pair's own facets are left out by the
@@ -272,25 +264,22 @@ impl<T: Real> Context<'_, T> {
                 if si.entry == sj.entry {
                     continue;
                 }
-                {
-                    let (on, other) = if s.entry == si.entry { (pi, j) } else { (pj, i) };
-                    let solid = scene.geom(on);
-                    if !solid.concave() {
-                        continue;
-                    }
-                    let po = &scene.patches[other];
-                    if inside_solid(solid, scene.geom(po), po, self.balls[other], self.tol) {
-                        continue;
-                    }
+                let (on, other) = if s.entry == si.entry { (pi, j) } else { (pj, i) };
+                if !concave(on) {
+                    continue;
+                }
+                let po = &scene.patches[other];
+                if inside_solid(scene.geom(on), scene.geom(po), po, self.balls[other], self.tol) {
+                    continue;
                 }
             }
-            for (occluder, piece) in self.occluders[k].iter().zip(&s.pieces) {
+            for (occluder, plane) in self.occluders[k].iter().zip(&self.piece_planes[k]) {
                 if !occluder.may_block_between(bi, bj) {
                     continue;
                 }
-                if let Some(plane) = piece.geom.plane() {
-                    let (lo_i, hi_i) = gi.distance_range(pi.rect, &plane);
-                    let (lo_j, hi_j) = gj.distance_range(pj.rect, &plane);
+                if let Some(plane) = plane {
+                    let (lo_i, hi_i) = gi.distance_range(pi.rect, plane);
+                    let (lo_j, hi_j) = gj.distance_range(pj.rect, plane);
                     if (lo_i >= -self.tol && lo_j >= -self.tol) || (hi_i <= self.tol && hi_j <= self.tol) {
                         continue;
                     }
@@ -376,17 +365,38 @@ fn compute_with<T: Real, const CAP: usize>(
     let at = |i: usize| move |error| PairError { i, j: i, error };
     let mut shapes = Vec::with_capacity(scene.surfaces.len());
     let mut occluders = Vec::with_capacity(scene.surfaces.len());
-    for s in &scene.surfaces {
-        let first = scene.patches.iter().position(|p| scene.surfaces[p.surface].name == s.name).unwrap_or(0);
+    for (k, s) in scene.surfaces.iter().enumerate() {
+        let first = scene.patches.iter().position(|p| p.surface == k).unwrap_or(0);
         let list = s.pieces.iter().map(|p| p.geom.shape::<T>()).collect::<Result<Vec<_>, _>>().map_err(at(first))?;
         // Every piece of an occluding surface is one (the scene's builder refuses `occludes` on
         // parts of surfaces, which have none).
-        // refuses `occludes` where there is none).
         occluders.push(if s.occludes { list.iter().filter_map(occluder_of).collect() } else { Vec::new() });
         shapes.push(list);
     }
-    let mut ctx =
-        Context { scene, shapes, occluders, info: Vec::new(), balls: Vec::new(), planes: Vec::new(), tol: 0.0 };
+    let stands = (0..scene.surfaces.len())
+        .map(|k| {
+            let s = &scene.surfaces[k];
+            !occluders[k].is_empty()
+                && !scene.surfaces[..k]
+                    .iter()
+                    .zip(&occluders)
+                    .any(|(o, list)| o.entry == s.entry && o.group == s.group && !list.is_empty())
+        })
+        .collect();
+    let piece_concave = scene.surfaces.iter().map(|s| s.pieces.iter().map(|p| p.geom.concave()).collect()).collect();
+    let piece_planes = scene.surfaces.iter().map(|s| s.pieces.iter().map(|p| p.geom.plane()).collect()).collect();
+    let mut ctx = Context {
+        scene,
+        shapes,
+        occluders,
+        info: Vec::new(),
+        balls: Vec::new(),
+        planes: Vec::new(),
+        piece_concave,
+        piece_planes,
+        stands,
+        tol: 0.0,
+    };
     let mut info = Vec::with_capacity(scene.patches.len());
     for (i, p) in scene.patches.iter().enumerate() {
         let patch = ctx.patch(i).map_err(at(i))?;

@@ -100,6 +100,13 @@ pub enum Geom {
     Bezier { control: [[Vec3<f64>; 4]; 4] },
 }
 
+/// The corners of a parallelogram's patch on `r` (it is their convex hull).
+pub fn corners(origin: Vec3<f64>, edge_t: Vec3<f64>, edge_s: Vec3<f64>, r: Rect) -> impl Iterator<Item = Vec3<f64>> {
+    [(r.t0, r.s0), (r.t1, r.s0), (r.t0, r.s1), (r.t1, r.s1)]
+        .into_iter()
+        .map(move |(t, s)| origin + edge_t.scale(t) + edge_s.scale(s))
+}
+
 /// Bounds [min, max] of a cos θ + b sin θ over θ ∈ [θ₀, θ₁] (exact: the ends and the
 /// stationary points inside).
 fn trig_range(a: f64, b: f64, t0: f64, t1: f64) -> (f64, f64) {
@@ -241,16 +248,9 @@ impl Geom {
     pub fn distance_range(&self, rect: Rect, plane: &Plane) -> (f64, f64) {
         let n = plane.normal;
         match *self {
-            Self::Parallelogram { origin, edge_t, edge_s } => {
-                let mut lo = f64::MAX;
-                let mut hi = -f64::MAX;
-                for (t, s) in [(rect.t0, rect.s0), (rect.t1, rect.s0), (rect.t0, rect.s1), (rect.t1, rect.s1)] {
-                    let d = plane.distance(origin + edge_t.scale(t) + edge_s.scale(s));
-                    lo = lo.min(d);
-                    hi = hi.max(d);
-                }
-                (lo, hi)
-            }
+            Self::Parallelogram { origin, edge_t, edge_s } => corners(origin, edge_t, edge_s, rect)
+                .map(|x| plane.distance(x))
+                .fold((f64::MAX, -f64::MAX), |(lo, hi), d| (lo.min(d), hi.max(d))),
             Self::Disk { center, frame, .. } => {
                 let c = plane.distance(center);
                 let (lo, hi) = trig_range(n.dot(frame.u), n.dot(frame.w), rect.s0, rect.s1);

@@ -129,7 +129,7 @@ impl<T: Real> Probe<T> {
 
     fn hits(&self, net: &Net<T>, level: u32) -> bool {
         let (c, r) = net_ball(net);
-        if distance_to_segment(c, self.p, self.q) > r + self.flat {
+        if distance_point_segment(c, self.p, self.q) > r + self.flat {
             return false;
         }
         if level >= MAX_LEVELS || flatness(net) <= self.flat {
@@ -163,13 +163,6 @@ impl<T: Real> Probe<T> {
         let (a, b) = split_s(&hi);
         self.hits(&a, level + 1) || self.hits(&b, level + 1)
     }
-}
-
-fn distance_to_segment<T: Real>(c: Vec3<T>, p: Vec3<T>, q: Vec3<T>) -> T {
-    let d = q - p;
-    let dd = d.norm2();
-    let tau = if dd > T::ZERO { ((c - p).dot(d) / dd).max(T::ZERO).min(T::ONE) } else { T::ZERO };
-    (c - (p + d.scale(tau))).norm()
 }
 
 impl<T: Real> Occluder<T> for BezierPatch<T> {

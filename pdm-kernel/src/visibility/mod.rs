@@ -121,7 +121,7 @@ pub(crate) fn ball_may_cut_pair<T: Real>(c: Vec3<T>, r: T, a: &Ball<T>, b: &Ball
     distance <= r + scale * T::GEOMETRY_TOLERANCE
 }
 
-#[cfg(not(feature = "closed-form"))]
+/// Distance from c to the segment a–b.
 fn distance_point_segment<T: Real>(c: Vec3<T>, a: Vec3<T>, b: Vec3<T>) -> T {
     let d = b - a;
     let dd = d.norm2();
