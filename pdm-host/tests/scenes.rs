@@ -213,6 +213,22 @@ fn bad_scenes_are_named_errors() {
             &["`occludes`", "no occluder for a part of a cone"],
         ),
         (format!("{rect}subdivide = [0, 3]\n"), &["`subdivide`"]),
+        (
+            "[[surface]]\nname = \"t\"\nkind = \"triangle\"\nvertices = [[0, 0, 0], [1, 0, 0]]\n".to_string(),
+            &["'t'", "`vertices`", "must be 3 points, got 2"],
+        ),
+        (
+            "[[surface]]\nname = \"t\"\nkind = \"triangle\"\nvertices = [[0, 0, 0], [1, 0, 0], [2, 0, 0]]\n".to_string(),
+            &["'t'", "`vertices`", "zero area"],
+        ),
+        (
+            "[[surface]]\nname = \"q\"\nkind = \"quadrilateral\"\nvertices = [[0, 0, 0], [2, 0, 0], [0.5, 0.5, 0], [0, 2, 0]]\n".to_string(),
+            &["'q'", "`vertices`", "not convex"],
+        ),
+        (
+            "[[surface]]\nname = \"q\"\nkind = \"quadrilateral\"\nvertices = [[0, 0, 0], [1, 0, 0], [1, 1, 0.2], [0, 1, 0]]\n".to_string(),
+            &["'q'", "`vertices`", "not flat"],
+        ),
         (format!("{rect}subdivide = [1000, 1000]\n"), &["more than 5000 patches"]),
         (format!("{rect}side = \"inner\"\n"), &["`side`", "front, back or both"]),
         (
@@ -352,8 +368,9 @@ fn obj_cube_against_c11_and_c14() {
     let adjacent = closed_form::perpendicular_rectangles(1.0, 1.0, 1.0); // C-14
     check(&r, "cube/floor", "cube/ceiling", opposite, 1e-9);
     check(&r, "cube/west", "cube/east", opposite, 1e-9);
+    // Facet pairs take the contour form with closed-form inner integrals: exact to rounding.
     for (a, b) in [("cube/floor", "cube/south"), ("cube/floor", "cube/north"), ("cube/west", "cube/north")] {
-        check(&r, a, b, adjacent, 1e-4);
+        check(&r, a, b, adjacent, 1e-10);
     }
     for (i, sum) in r.surfaces.row_sums.iter().enumerate() {
         let allowed: f64 = r.surfaces.errors.as_ref().unwrap()[i].iter().sum();
@@ -380,4 +397,65 @@ fn stl_square_under_a_rectangle() {
     std::fs::remove_file(dir.path().join("sq.stl")).unwrap();
     let e = pdm_host::scene::load(&path).unwrap_err().to_string();
     assert!(e.contains("surface #1 'square': field `file`") && e.contains("sq.stl"), "{e}");
+}
+
+/// The triangle and quadrilateral kinds: a unit square floor as two triangles (one of them
+/// subdivided, so that patches at its collapsed corner are triangles too), a wall sharing its
+/// edge and a ceiling as quadrilaterals, against C-14 and C-11; a quadrilateral radiating to
+/// its back sees nothing.
+#[test]
+fn triangles_and_quadrilaterals_against_c11_and_c14() {
+    let text = r#"
+[[surface]]
+name = "floor1"
+kind = "triangle"
+vertices = [[0, 0, 0], [1, 0, 0], [1, 1, 0]]
+subdivide = [3, 2]
+
+[[surface]]
+name = "floor2"
+kind = "triangle"
+vertices = [[0, 0, 0], [1, 1, 0], [0, 1, 0]]
+
+[[surface]]
+name = "wall"
+kind = "quadrilateral"
+vertices = [[0, 0, 0], [0, 0, 1], [1, 0, 1], [1, 0, 0]]
+subdivide = [2, 2]
+
+[[surface]]
+name = "ceiling"
+kind = "quadrilateral"
+vertices = [[0, 0, 1], [0, 1, 1], [1, 1, 1], [1, 0, 1]]
+
+[[surface]]
+name = "away"
+kind = "quadrilateral"
+vertices = [[0, 0, 2], [0, 1, 2], [1, 1, 2], [1, 0, 2]]
+side = "back"
+occludes = false
+"#;
+    let s = scene(text);
+    let r = run(&s, PairMethod::Tolerance(1e-10));
+    let (area1, area2) = (0.5, 0.5);
+    // The floor's exchange with the wall and the ceiling, summed over its two halves.
+    let to = |b: &str| area1 * factor(&r, "floor1", b) + area2 * factor(&r, "floor2", b);
+    let err = |b: &str| area1 * error(&r, "floor1", b) + area2 * error(&r, "floor2", b);
+    for (b, exact) in [
+        ("wall", closed_form::perpendicular_rectangles(1.0, 1.0, 1.0)), // C-14
+        ("ceiling", closed_form::parallel_rectangles(1.0, 1.0, 1.0)),   // C-11
+    ] {
+        let actual = (to(b) - exact).abs();
+        assert!(
+            actual <= 1e-10 * exact && actual <= err(b) + 1e-15,
+            "floor -> {b}: {} vs {exact} (estimate {:e})",
+            to(b),
+            err(b)
+        );
+    }
+    // The wall to the ceiling: C-14 again.
+    check(&r, "wall", "ceiling", closed_form::perpendicular_rectangles(1.0, 1.0, 1.0), 1e-10);
+    for b in ["floor1", "floor2", "wall", "ceiling"] {
+        assert_eq!(factor(&r, "away", b), 0.0, "away -> {b}");
+    }
 }

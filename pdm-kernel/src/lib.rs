@@ -103,8 +103,8 @@ pub use real::Real;
 pub use samples::{Ball, PatchSamples, Sample};
 pub use substructure::{capacity_for, surface_exchange, with_capacity, Method, WithCapacity, CAPACITIES};
 pub use surface::{
-    AutoNormal, BezierPatch, Cone, Cylinder, Disk, Flipped, Frame, Parallelogram, ParamRect, ParametricMap, Side,
-    Sphere, Surface,
+    AutoNormal, BezierPatch, Cone, Cylinder, Disk, Flipped, Frame, Parallelogram, ParamRect, ParametricMap,
+    Quadrilateral, Side, Sphere, Surface,
 };
 pub use vec3::{vec3, Vec3};
 pub use visibility::{mutually_facing, AnyOccluder, Occluder};

@@ -261,6 +261,24 @@ fn geometry(i: usize, spec: &SurfaceSpec, flip: bool, place: &Place, base: &Path
             };
             Ok(vec![(String::new(), vec![(g, ParamRect { t0: a, t1: b, s0: 0.0, s1: height })])])
         }
+        Kind::Triangle | Kind::Quadrilateral => {
+            let count = if spec.kind == Kind::Triangle { 3 } else { 4 };
+            let Some(points) = &spec.vertices else {
+                return fail(i, spec, "vertices", format!("missing (kind {} needs it)", spec.kind.name()));
+            };
+            if points.len() != count {
+                return fail(i, spec, "vertices", format!("must be {count} points, got {}", points.len()));
+            }
+            if let Some(k) = points.iter().position(|p| !finite3(*p)) {
+                return fail(i, spec, "vertices", format!("point [{k}] is not finite"));
+            }
+            let v: Vec<Vec3<f64>> = points.iter().map(|p| place.point(v3(*p))).collect();
+            let corners = if let [a, b, c] = v[..] { [a, b, c, a] } else { [v[0], v[1], v[2], v[3]] };
+            if let Err(problem) = super::mesh::check_polygon(&corners) {
+                return fail(i, spec, "vertices", problem);
+            }
+            full(Geom::Quadrilateral { corners: if flip { reversed(corners) } else { corners } })
+        }
         Kind::Bezier => {
             let Some(net) = &spec.control else { return fail(i, spec, "control", "missing (kind bezier needs it)") };
             let rows = net.len();
@@ -317,21 +335,17 @@ fn geometry(i: usize, spec: &SurfaceSpec, flip: bool, place: &Place, base: &Path
                             format!("{}: facet {} has a non-finite vertex", path.display(), k + 1),
                         );
                     }
-                    let area = (t[1] - t[0]).cross(t[2] - t[0]).norm();
-                    let size = (t[1] - t[0]).norm().max((t[2] - t[0]).norm());
-                    if !(area > 1e-12 * size * size) {
+                    let [a, b, c] = t.map(|p| place.point(p));
+                    let corners = [a, b, c, a];
+                    if let Err(problem) = super::mesh::check_polygon(&corners) {
                         return fail(
                             i,
                             spec,
                             "file",
-                            format!("{}: facet {} ({group}) has zero area", path.display(), k + 1),
+                            format!("{}: facet {} ({group}): {problem}", path.display(), k + 1),
                         );
                     }
-                    let mut control = super::mesh::triangle_net(t).map(|row| row.map(|p| place.point(p)));
-                    if flip {
-                        control = transpose(&control);
-                    }
-                    let g = Geom::Bezier { control };
+                    let g = Geom::Quadrilateral { corners: if flip { reversed(corners) } else { corners } };
                     pieces.push((g, g.domain()));
                 }
                 out.push((if several { format!("/{group}") } else { String::new() }, pieces));
@@ -341,18 +355,14 @@ fn geometry(i: usize, spec: &SurfaceSpec, flip: bool, place: &Place, base: &Path
     }
 }
 
+/// The same quadrilateral radiating to the other side: P₀ kept, the others reversed, which
+/// transposes its map (t and s swap).
+fn reversed([p0, p1, p2, p3]: [Vec3<f64>; 4]) -> [Vec3<f64>; 4] {
+    [p0, p3, p2, p1]
+}
+
 /// Pieces of one entry's side by group (a mesh file's objects; one unnamed group otherwise).
 type Groups = Vec<(String, Vec<(Geom, Rect)>)>;
-
-fn transpose(n: &[[Vec3<f64>; 4]; 4]) -> [[Vec3<f64>; 4]; 4] {
-    let mut t = *n;
-    for (i, row) in n.iter().enumerate() {
-        for (j, &p) in row.iter().enumerate() {
-            t[j][i] = p;
-        }
-    }
-    t
-}
 
 /// Arc length of the parameter line through the middle of `rect` along t (`along_t`) or s.
 fn mid_length(geom: &Geom, rect: Rect, along_t: bool) -> f64 {
@@ -445,7 +455,15 @@ pub fn build_in(file: &SceneFile, base: &Path) -> Result<Scene, EntryError> {
                         match (spec.subdivide, spec.patch_size) {
                             // A flipped Bézier net is transposed: its grid too, so that its cells are
                             // the front's.
-                            (Some([m, n]), _) if flip && matches!(spec.kind, Kind::Bezier | Kind::Mesh) => (n, m),
+                            (Some([m, n]), _)
+                                if flip
+                                    && matches!(
+                                        spec.kind,
+                                        Kind::Bezier | Kind::Mesh | Kind::Triangle | Kind::Quadrilateral
+                                    ) =>
+                            {
+                                (n, m)
+                            }
                             (Some([m, n]), _) => (m, n),
                             (None, Some(size)) => {
                                 let count = |along_t| (mid_length(&geom, rect, along_t) / size).ceil().max(1.0);

@@ -233,7 +233,13 @@ impl<T: Real> Context<'_, T> {
         // Patches of one convex side of a sphere, tube or cone, or one flat sheet, never see
         // each other (a chord of a convex solid leaves it only at its ends).
         let concave = |p: &ScenePatch| self.piece_concave[p.surface][p.piece];
-        if si.entry == sj.entry && pi.surface == pj.surface && !concave(pi) && !matches!(gi, Geom::Bezier { .. }) {
+        // A mesh group's facets (quadrilaterals) may face each other; one facet's patches do not.
+        let one_sheet = match gi {
+            Geom::Bezier { .. } => false,
+            Geom::Quadrilateral { .. } => pi.piece == pj.piece,
+            _ => true,
+        };
+        if si.entry == sj.entry && pi.surface == pj.surface && !concave(pi) && one_sheet {
             return Plan::Skip;
         }
         // The two sides of one sheet or closed surface: a segment between two of its points is

@@ -1,8 +1,9 @@
 //! Flat facets from mesh files: OBJ (`tobj`, in f64, every face triangulated, one group per OBJ
-//! object or group) and STL (`stl_io`, ASCII or binary, one group). Each triangle becomes a
-//! bicubic Bézier net with one side collapsed to a vertex, g(t, s) = A + t·(B − A + s·(C − B)),
-//! whose normal t·(B − A) × (C − A) points to the side the vertices A, B, C turn
-//! counter-clockwise around.
+//! object or group) and STL (`stl_io`, ASCII or binary, one group). Each triangle A B C becomes
+//! the kernel's `Quadrilateral` A B C A, g(t, s) = A + t·(B − A + s·(C − B)), whose normal
+//! t·(B − A) × (C − A) points to the side the vertices turn counter-clockwise around: a flat
+//! facet with straight edges, so facet pairs that see each other wholly take the contour form
+//! in closed form, and an exact occluder.
 
 use std::path::Path;
 
@@ -62,17 +63,26 @@ pub fn load(path: &Path) -> Result<Vec<(String, Vec<Triangle>)>, String> {
     }
 }
 
-/// The Bézier net of a triangle (module docs): control point (i, j) = g(i/3, j/3), exact
-/// because g is of degree one in each parameter.
-#[must_use]
-pub fn triangle_net(t: &Triangle) -> [[Vec3<f64>; 4]; 4] {
-    let [a, b, c] = *t;
-    let mut net = [[a; 4]; 4];
-    for (i, row) in net.iter_mut().enumerate() {
-        for (j, p) in row.iter_mut().enumerate() {
-            let (u, v) = (i as f64 / 3.0, j as f64 / 3.0);
-            *p = a + (b - a + (c - b).scale(v)).scale(u);
+/// Why four corners (a triangle repeats its first) do not make a flat convex quadrilateral
+/// of non-zero area, in words for the error message; the same conditions as
+/// `pdm_kernel::Quadrilateral::new`, with a relative tolerance of 1e-9.
+pub fn check_polygon(c: &[Vec3<f64>; 4]) -> Result<(), String> {
+    let [p0, p1, p2, p3] = *c;
+    let n = (p2 - p0).cross(p3 - p1);
+    let size = (p2 - p0).norm().max((p3 - p1).norm());
+    if !(n.norm() > 1e-9 * size * size) {
+        return Err("has zero area (corners on one line or coincident)".into());
+    }
+    let unit = n.scale(1.0 / n.norm());
+    let centre = (p0 + p1 + p2 + p3).scale(0.25);
+    if c.iter().any(|p| unit.dot(*p - centre).abs() > 1e-9 * size) {
+        return Err("is not flat (a corner lies off the plane of the others)".into());
+    }
+    for k in 0..4 {
+        let (prev, p, next) = (c[(k + 3) % 4], c[k], c[(k + 1) % 4]);
+        if unit.dot((p - prev).cross(next - p)) < -1e-9 * size * size {
+            return Err(format!("is not convex, or its sides cross (at corner {k})"));
         }
     }
-    net
+    Ok(())
 }

@@ -42,6 +42,10 @@ pub enum Kind {
     Cylinder,
     /// A cone or conical frustum (`theta` for part of it).
     Cone,
+    /// A flat triangle, `vertices` A, B, C.
+    Triangle,
+    /// A flat convex quadrilateral, `vertices` P₀ … P₃ in order around it.
+    Quadrilateral,
     /// Bicubic Bézier patches: a (3m + 1) × (3n + 1) control net, m × n patches sharing edges.
     Bezier,
     /// Flat facets from a mesh file (OBJ or STL), one surface per OBJ object or group.
@@ -58,6 +62,8 @@ impl Kind {
             Self::Sphere => "sphere",
             Self::Cylinder => "cylinder",
             Self::Cone => "cone",
+            Self::Triangle => "triangle",
+            Self::Quadrilateral => "quadrilateral",
             Self::Bezier => "bezier",
             Self::Mesh => "mesh",
         }
@@ -76,7 +82,7 @@ impl Kind {
 #[serde(rename_all = "snake_case")]
 pub enum SideSpec {
     /// Sheets: the side the normal points to (rectangle: edge_t × edge_s; disk: `normal`;
-    /// Bézier: ∂g/∂t × ∂g/∂s).
+    /// triangle, quadrilateral, mesh facet: counter-clockwise vertices; Bézier: ∂g/∂t × ∂g/∂s).
     Front,
     /// Sheets: the other side.
     Back,
@@ -172,6 +178,10 @@ pub struct SurfaceSpec {
     /// Default `[0, 180]`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub phi: Option<[f64; 2]>,
+    /// Triangle (3 points), quadrilateral (4 points, convex, in one plane): the corners in
+    /// order; the front side is the one they turn counter-clockwise around.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vertices: Option<Vec<[f64; 3]>>,
     /// Bézier: the control net, (3m + 1) rows along t of (3n + 1) points along s.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub control: Option<Vec<Vec<[f64; 3]>>>,
@@ -205,6 +215,7 @@ impl SurfaceSpec {
         check(self.height.is_some(), "height");
         check(self.theta.is_some(), "theta");
         check(self.phi.is_some(), "phi");
+        check(self.vertices.is_some(), "vertices");
         check(self.control.is_some(), "control");
         check(self.file.is_some(), "file");
         set
@@ -220,6 +231,7 @@ pub fn fields_of(kind: Kind) -> (&'static [&'static str], &'static [&'static str
         Kind::Sphere => (&["center", "radius"], &["axis", "phi", "theta"]),
         Kind::Cylinder => (&["base", "axis", "radius", "height"], &["theta"]),
         Kind::Cone => (&["base", "axis", "base_radius", "top_radius", "height"], &["theta"]),
+        Kind::Triangle | Kind::Quadrilateral => (&["vertices"], &[]),
         Kind::Bezier => (&["control"], &[]),
         Kind::Mesh => (&["file"], &[]),
     }

@@ -4,8 +4,8 @@
 //! from a plane), and [`Shape`], the kernel surface it becomes in the working precision.
 
 use pdm_kernel::{
-    vec3, AnyOccluder, BezierPatch, Cone, Cylinder, Disk, Frame, Parallelogram, ParamRect, Patch, PdmError, Real, Side,
-    Sphere, Surface, Vec3,
+    vec3, AnyOccluder, BezierPatch, Cone, Cylinder, Disk, Frame, Parallelogram, ParamRect, Patch, PdmError,
+    Quadrilateral, Real, Side, Sphere, Surface, Vec3,
 };
 
 /// One kernel surface of a scene: a built-in kind.
@@ -23,6 +23,8 @@ pub enum Shape<T> {
     Cone(Cone<T>),
     /// A bicubic Bézier patch.
     Bezier(BezierPatch<T>),
+    /// A flat convex quadrilateral or triangle (a mesh facet).
+    Quadrilateral(Quadrilateral<T>),
 }
 
 macro_rules! each {
@@ -34,6 +36,7 @@ macro_rules! each {
             Shape::Cylinder($s) => $e,
             Shape::Cone($s) => $e,
             Shape::Bezier($s) => $e,
+            Shape::Quadrilateral($s) => $e,
         }
     };
 }
@@ -56,6 +59,9 @@ impl<T: Real> Surface<T> for Shape<T> {
     }
     fn point_and_partials(&self, t: T, s: T) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {
         each!(self, g => g.point_and_partials(t, s))
+    }
+    fn straight_corners(&self, rect: ParamRect<T>) -> Option<[Vec3<T>; 4]> {
+        each!(self, g => g.straight_corners(rect))
     }
 }
 
@@ -98,6 +104,9 @@ pub enum Geom {
     Cone { base: Vec3<f64>, frame: Frame<f64>, base_radius: f64, top_radius: f64, height: f64, inner: bool },
     /// Control net, rows along t.
     Bezier { control: [[Vec3<f64>; 4]; 4] },
+    /// The bilinear map of four coplanar corners, counter-clockwise about the radiating side (a
+    /// triangle repeats its first corner last).
+    Quadrilateral { corners: [Vec3<f64>; 4] },
 }
 
 /// The corners of a parallelogram's patch on `r` (it is their convex hull).
@@ -105,6 +114,13 @@ pub fn corners(origin: Vec3<f64>, edge_t: Vec3<f64>, edge_s: Vec3<f64>, r: Rect)
     [(r.t0, r.s0), (r.t1, r.s0), (r.t0, r.s1), (r.t1, r.s1)]
         .into_iter()
         .map(move |(t, s)| origin + edge_t.scale(t) + edge_s.scale(s))
+}
+
+/// The bilinear map of four corners at (t, s) (`pdm_kernel::Quadrilateral`'s map).
+#[must_use]
+pub fn bilinear(c: &[Vec3<f64>; 4], t: f64, s: f64) -> Vec3<f64> {
+    let [p0, p1, p2, p3] = *c;
+    p0.scale((1.0 - t) * (1.0 - s)) + p1.scale(t * (1.0 - s)) + p2.scale(t * s) + p3.scale((1.0 - t) * s)
 }
 
 /// Bounds [min, max] of a cos θ + b sin θ over θ ∈ [θ₀, θ₁] (exact: the ends and the
@@ -166,6 +182,7 @@ impl Geom {
                 side(inner),
             )?),
             Self::Bezier { control } => Shape::Bezier(BezierPatch::new(control.map(|row| row.map(to_t)))?),
+            Self::Quadrilateral { corners } => Shape::Quadrilateral(Quadrilateral::new(corners.map(to_t))?),
         })
     }
 
@@ -174,7 +191,7 @@ impl Geom {
     pub fn domain(&self) -> Rect {
         let two_pi = 2.0 * core::f64::consts::PI;
         let (t1, s1) = match *self {
-            Self::Parallelogram { .. } | Self::Bezier { .. } => (1.0, 1.0),
+            Self::Parallelogram { .. } | Self::Bezier { .. } | Self::Quadrilateral { .. } => (1.0, 1.0),
             Self::Disk { outer, .. } => (outer, two_pi),
             Self::Sphere { .. } => (core::f64::consts::PI, two_pi),
             Self::Cylinder { height, .. } | Self::Cone { height, .. } => (two_pi, height),
@@ -186,7 +203,7 @@ impl Geom {
         ParamRect { t0, t1, s0: 0.0, s1 }
     }
 
-    /// The plane of a flat kind (parallelogram, disk), its normal on the radiating side.
+    /// The plane of a flat kind (parallelogram, disk, quadrilateral, flat Bézier net), its normal on the radiating side.
     #[must_use]
     pub fn plane(&self) -> Option<Plane> {
         match *self {
@@ -195,6 +212,10 @@ impl Geom {
                 Some(Plane { origin, normal: n.scale(1.0 / n.norm()) })
             }
             Self::Disk { center, frame, .. } => Some(Plane { origin: center, normal: frame.axis }),
+            Self::Quadrilateral { corners: [p0, p1, p2, p3] } => {
+                let n = (p2 - p0).cross(p3 - p1);
+                Some(Plane { origin: p0, normal: n.scale(1.0 / n.norm()) })
+            }
             Self::Bezier { control } => {
                 // A flat net (a mesh facet): its control points in one plane, normal to the
                 // diagonals of the corners, on the side of ∂g/∂t × ∂g/∂s.
@@ -241,7 +262,7 @@ impl Geom {
     }
 
     /// Conservative bounds [min, max] of the signed distance from `plane` over the patch on
-    /// `rect`: exact for parallelograms, disks, tubes and cones (closed-form extremes), the
+    /// `rect`: exact for parallelograms, quadrilaterals, disks, tubes and cones (closed-form extremes), the
     /// control points for a whole Bézier net (its convex hull holds it), the patch's enclosing
     /// ball ([`Patch::enclosing_ball`]) for spheres and parts of Bézier nets.
     #[must_use]
@@ -251,6 +272,13 @@ impl Geom {
             Self::Parallelogram { origin, edge_t, edge_s } => corners(origin, edge_t, edge_s, rect)
                 .map(|x| plane.distance(x))
                 .fold((f64::MAX, -f64::MAX), |(lo, hi), d| (lo.min(d), hi.max(d))),
+            // A patch of the bilinear map is the convex quadrilateral of its corners' images.
+            Self::Quadrilateral { corners } => {
+                [(rect.t0, rect.s0), (rect.t1, rect.s0), (rect.t1, rect.s1), (rect.t0, rect.s1)]
+                    .into_iter()
+                    .map(|(t, s)| plane.distance(bilinear(&corners, t, s)))
+                    .fold((f64::MAX, -f64::MAX), |(lo, hi), d| (lo.min(d), hi.max(d)))
+            }
             Self::Disk { center, frame, .. } => {
                 let c = plane.distance(center);
                 let (lo, hi) = trig_range(n.dot(frame.u), n.dot(frame.w), rect.s0, rect.s1);
@@ -309,5 +337,6 @@ pub fn occluder_of<T: Real>(shape: &Shape<T>) -> Option<AnyOccluder<T>> {
         Shape::Cylinder(c) => Some(AnyOccluder::Cylinder(c)),
         Shape::Cone(c) => Some(AnyOccluder::Cone(c)),
         Shape::Bezier(b) => Some(AnyOccluder::Bezier(b)),
+        Shape::Quadrilateral(q) => Some(AnyOccluder::Quadrilateral(q)),
     }
 }

@@ -191,3 +191,51 @@ mod point_form_tests {
         }
     }
 }
+
+/// Triangles and general quadrilaterals (straight corners, [`crate::Quadrilateral`]) by the
+/// closed-form inner integrals against the same flat patches as Bézier nets, whose pairs take
+/// the curved-outline rules (`curve.rs`: the inner integral by graded Gauss rules, no closed
+/// form): separate, sharing an edge, sharing a vertex, and patches of subdivided triangles
+/// (a patch at the collapsed corner is itself a triangle).
+#[test]
+fn triangles_and_quadrilaterals_match_their_bezier_nets() {
+    use crate::surface::{BezierPatch, Quadrilateral};
+    use crate::{adaptive_exchange, Adaptive, ParamRect};
+    let net = |q: &Quadrilateral<f64>| {
+        let mut n = [[vec3(0.0, 0.0, 0.0); 4]; 4];
+        for (i, row) in n.iter_mut().enumerate() {
+            for (j, p) in row.iter_mut().enumerate() {
+                *p = q.point(i as f64 / 3.0, j as f64 / 3.0);
+            }
+        }
+        BezierPatch::new(n).unwrap()
+    };
+    let (o, x, z) = (vec3(0.0, 0.0, 0.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 0.0, 1.0));
+    let floor = Quadrilateral::triangle(o, x, vec3(0.8, 1.1, 0.0)).unwrap();
+    let floor_quad = Quadrilateral::new([o, x, vec3(1.2, 0.9, 0.0), vec3(-0.1, 0.7, 0.0)]).unwrap();
+    let cases = [
+        // Shared edge o–x, perpendicular.
+        (floor, Quadrilateral::triangle(o, vec3(0.3, 0.0, 0.9), x).unwrap()),
+        // Shared vertex o, at an angle.
+        (floor, Quadrilateral::triangle(o, vec3(-0.5, 0.6, 0.4), vec3(-0.4, -0.3, 0.8)).unwrap()),
+        // Separate, tilted, quadrilateral against triangle.
+        (floor_quad, Quadrilateral::triangle(vec3(0.2, 0.1, 0.7), vec3(0.3, 0.9, 1.0), vec3(1.1, 0.4, 0.8)).unwrap()),
+        // Shared edge between two quadrilaterals.
+        (floor_quad, Quadrilateral::new([o, z, vec3(1.1, 0.0, 0.8), x]).unwrap()),
+    ];
+    let rects = [ParamRect { t0: 0.0, t1: 1.0, s0: 0.0, s1: 1.0 }, ParamRect { t0: 0.0, t1: 0.5, s0: 0.25, s1: 0.75 }];
+    for (k, (a, b)) in cases.iter().enumerate() {
+        for ra in rects {
+            let (pa, pb) = (Patch::new(a, ra).unwrap(), Patch::whole(b).unwrap());
+            let fast = adaptive_exchange::<f64, _, _, _, 256>(&pa, &pb, Adaptive::new(1e-12), &()).unwrap();
+            let (na, nb) = (net(a), net(b));
+            let (qa, qb) = (Patch::new(&na, ra).unwrap(), Patch::whole(&nb).unwrap());
+            let slow = adaptive_exchange::<f64, _, _, _, 256>(&qa, &qb, Adaptive::new(1e-12), &()).unwrap();
+            let rel = (fast.value - slow.value).abs() / slow.value;
+            assert!(fast.value > 0.0 && rel < 1e-11, "case {k} {ra:?}: {} vs {} ({rel:e})", fast.value, slow.value);
+            assert!(fast.error.unwrap() < 1e-11 * fast.value, "case {k}: {:?}", fast.error);
+            // The closed-form inner integrals need far fewer evaluations than the graded ones.
+            assert!(fast.evaluations * 10 < slow.evaluations, "case {k}: {} vs {}", fast.evaluations, slow.evaluations);
+        }
+    }
+}

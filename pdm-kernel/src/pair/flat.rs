@@ -83,13 +83,13 @@ pub(super) enum FlatShape<'p, 'r, T: Real, SA: Surface<T> + ?Sized, SB: Surface<
     Outlines(crate::contour::Outline<'p, T, SA>, crate::contour::Outline<'r, T, SB>),
 }
 
-/// A flat patch's corners counter-clockwise about its radiating normal, and its unit normal.
+/// A flat patch's corners counter-clockwise about its radiating normal, and its unit normal:
+/// patches with straight edges ([`Surface::straight_corners`]: parallelograms, quadrilaterals,
+/// triangles, whose repeated corner is an edge of length zero that contributes nothing).
 #[cfg(feature = "closed-form")]
 pub(super) fn flat_corners<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>) -> Option<([Vec3<T>; 4], Vec3<T>)> {
-    let (o, et, es) = p.surface().affine_map()?;
     let r = p.rect();
-    let at = |t: T, s: T| o + et.scale(t) + es.scale(s);
-    let corners = [at(r.t0, r.s0), at(r.t1, r.s0), at(r.t1, r.s1), at(r.t0, r.s1)];
+    let corners = p.surface().straight_corners(r)?;
     let normal = p.surface().normal((r.t0 + r.t1) * T::HALF, (r.s0 + r.s1) * T::HALF);
     let length = normal.norm();
     if !(length > T::ZERO) || !length.is_finite() {
@@ -97,5 +97,6 @@ pub(super) fn flat_corners<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>)
     }
     let n = normal.scale(T::ONE / length);
     let [c0, c1, c2, c3] = corners;
-    Some(if n.dot(et.cross(es)) >= T::ZERO { (corners, n) } else { ([c0, c3, c2, c1], n) })
+    // The diagonals' cross product is twice the area vector of any planar quadrilateral.
+    Some(if n.dot((c2 - c0).cross(c3 - c1)) >= T::ZERO { (corners, n) } else { ([c0, c3, c2, c1], n) })
 }

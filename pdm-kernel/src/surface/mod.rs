@@ -7,7 +7,7 @@
 //!
 //! Two ways to get the normal:
 //! - closed form, written out for every built-in ([`Sphere`], [`Parallelogram`], [`Disk`],
-//!   [`Cylinder`], [`Cone`], [`BezierPatch`]);
+//!   [`Cylinder`], [`Cone`], [`BezierPatch`], [`Quadrilateral`] (and triangles));
 //! - automatically for any [`ParametricMap`], by forward-mode dual numbers: wrap it in
 //!   [`AutoNormal`]. Every built-in is also a `ParametricMap`, and the tests check that both ways
 //!   agree to rounding.
@@ -17,6 +17,7 @@ mod cone;
 mod cylinder;
 mod disk;
 mod parallelogram;
+mod quadrilateral;
 mod sphere;
 
 pub use bezier::BezierPatch;
@@ -24,6 +25,7 @@ pub use cone::Cone;
 pub use cylinder::Cylinder;
 pub use disk::Disk;
 pub use parallelogram::Parallelogram;
+pub use quadrilateral::Quadrilateral;
 pub use sphere::Sphere;
 
 use crate::dual::{Dual, Scalar};
@@ -133,6 +135,19 @@ pub trait Surface<T: Real> {
         let _ = (t, s);
         None
     }
+    /// `Some(corners)` if the patch over `rect` is flat with straight edges joining the images
+    /// of the rectangle's corners (t0, s0), (t1, s0), (t1, s1), (t0, s1), in that order (a side
+    /// collapsed to a point repeats a corner): a parallelogram's patches, a
+    /// [`Quadrilateral`]'s or a triangle's. Two such patches that see each other wholly take
+    /// the contour form with its inner line integrals in closed form. Default: the corners of
+    /// the [`affine_map`](Surface::affine_map), if there is one.
+    #[cfg(feature = "closed-form")]
+    #[inline]
+    fn straight_corners(&self, rect: ParamRect<T>) -> Option<[Vec3<T>; 4]> {
+        let (o, et, es) = self.affine_map()?;
+        let at = |t: T, s: T| o + et.scale(t) + es.scale(s);
+        Some([at(rect.t0, rect.s0), at(rect.t1, rect.s0), at(rect.t1, rect.s1), at(rect.t0, rect.s1)])
+    }
 }
 
 impl<T: Real, S: Surface<T> + ?Sized> Surface<T> for &S {
@@ -155,6 +170,10 @@ impl<T: Real, S: Surface<T> + ?Sized> Surface<T> for &S {
     #[cfg(feature = "closed-form")]
     fn point_and_partials(&self, t: T, s: T) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {
         (**self).point_and_partials(t, s)
+    }
+    #[cfg(feature = "closed-form")]
+    fn straight_corners(&self, rect: ParamRect<T>) -> Option<[Vec3<T>; 4]> {
+        (**self).straight_corners(rect)
     }
 }
 
@@ -244,6 +263,10 @@ impl<T: Real, S: Surface<T>> Surface<T> for Flipped<S> {
     #[cfg(feature = "closed-form")]
     fn point_and_partials(&self, t: T, s: T) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {
         self.0.point_and_partials(t, s)
+    }
+    #[cfg(feature = "closed-form")]
+    fn straight_corners(&self, rect: ParamRect<T>) -> Option<[Vec3<T>; 4]> {
+        self.0.straight_corners(rect)
     }
 }
 

@@ -20,6 +20,8 @@ pub enum AnyOccluder<T> {
     Cone(crate::surface::Cone<T>),
     /// A bicubic Bézier patch (to a tolerance: [`super::BEZIER_FLATNESS`]).
     Bezier(crate::surface::BezierPatch<T>),
+    /// A flat convex quadrilateral or triangle.
+    Quadrilateral(crate::surface::Quadrilateral<T>),
 }
 
 impl<T: Real> Occluder<T> for AnyOccluder<T> {
@@ -31,6 +33,7 @@ impl<T: Real> Occluder<T> for AnyOccluder<T> {
             Self::Cylinder(o) => o.blocks(p, q),
             Self::Cone(o) => o.blocks(p, q),
             Self::Bezier(o) => o.blocks(p, q),
+            Self::Quadrilateral(o) => o.blocks(p, q),
         }
     }
     fn may_block_between(&self, a: &Ball<T>, b: &Ball<T>) -> bool {
@@ -41,6 +44,7 @@ impl<T: Real> Occluder<T> for AnyOccluder<T> {
             Self::Cylinder(o) => o.may_block_between(a, b),
             Self::Cone(o) => o.may_block_between(a, b),
             Self::Bezier(o) => o.may_block_between(a, b),
+            Self::Quadrilateral(o) => o.may_block_between(a, b),
         }
     }
     #[cfg(feature = "closed-form")]
@@ -52,6 +56,7 @@ impl<T: Real> Occluder<T> for AnyOccluder<T> {
             Self::Cylinder(o) => o.line_polynomials(p, origin, direction, out),
             Self::Cone(o) => o.line_polynomials(p, origin, direction, out),
             Self::Bezier(o) => o.line_polynomials(p, origin, direction, out),
+            Self::Quadrilateral(o) => o.line_polynomials(p, origin, direction, out),
         }
     }
     #[cfg(feature = "closed-form")]

@@ -7,7 +7,7 @@
 //!
 //! **Occlusion.** An [`Occluder`] answers whether the open segment P_a → P_b crosses it. The
 //! built-in shapes are exact occluders (closed-form segment intersection): [`Sphere`],
-//! [`Parallelogram`], [`Disk`] (annulus), [`Cylinder`] (open tube), [`Cone`](crate::Cone)
+//! [`Parallelogram`], [`Quadrilateral`](crate::Quadrilateral) (and triangle), [`Disk`] (annulus), [`Cylinder`] (open tube), [`Cone`](crate::Cone)
 //! (cone or frustum); the [`BezierPatch`](crate::BezierPatch) occludes to a stated tolerance
 //! ([`BEZIER_FLATNESS`], by subdivision of its control net). Their *surface* is the
 //! obstacle: a segment crosses it where it enters or leaves, so two points on the inside of a
@@ -24,7 +24,7 @@
 //! built-in lists.
 //!
 //! Files: the trait and the bounding-ball tests here; one file per built-in shape
-//! (`sphere.rs`, `parallelogram.rs`, `disk.rs`, `cylinder.rs`, `cone.rs`, `bezier.rs`); the root finding they share
+//! (`sphere.rs`, `parallelogram.rs`, `quadrilateral.rs`, `disk.rs`, `cylinder.rs`, `cone.rs`, `bezier.rs`); the root finding they share
 //! (`roots.rs`); the combinations (`combine.rs`).
 
 use crate::real::Real;
@@ -40,6 +40,7 @@ mod cone;
 mod cylinder;
 mod disk;
 mod parallelogram;
+mod quadrilateral;
 mod roots;
 mod sphere;
 #[cfg(test)]
@@ -52,7 +53,7 @@ use roots::*;
 
 /// Something that may block the line of sight between two points.
 ///
-/// Sphere, parallelogram, disk, cylinder, cone and Bézier patch are occluders; several combine as a tuple, an
+/// Sphere, parallelogram, quadrilateral (and triangle), disk, cylinder, cone and Bézier patch are occluders; several combine as a tuple, an
 /// array, a slice or a `heapless::Vec` (of [`AnyOccluder`] to mix kinds), and `&()` means none.
 ///
 /// ```

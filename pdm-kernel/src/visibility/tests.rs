@@ -442,3 +442,62 @@ fn flat_bezier_blocks_near_its_plane_like_the_parallelogram() {
     }
     assert!(hits > 300 && tri_hits > 100 && tri_hits < hits, "{hits} {tri_hits}");
 }
+
+/// The quadrilateral occluder: a parallelogram-shaped one blocks exactly as the
+/// [`Parallelogram`]; a triangle blocks where the segment crosses the triangle's plane inside
+/// it (barycentric test); and its line polynomials vanish at every change of visibility.
+#[test]
+fn quadrilateral_and_triangle_block_as_their_outlines() {
+    use crate::surface::Quadrilateral;
+    let (o_, et, es) = (vec3(-0.4, 0.1, 0.0), vec3(2.0, 0.3, 0.0), vec3(-0.2, 1.7, 0.0));
+    let square = Parallelogram::new(o_, et, es).unwrap();
+    let quad = Quadrilateral::new([o_, o_ + et, o_ + et + es, o_ + es]).unwrap();
+    let (a, b, c) = (vec3(0.0, 0.0, 0.0), vec3(2.0, 0.2, 0.0), vec3(0.3, 1.9, 0.0));
+    let triangle = Quadrilateral::triangle(a, b, c).unwrap();
+    let mut state = 7u64;
+    let mut next = || {
+        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((state >> 11) as f64 / (1u64 << 53) as f64) * 3.0 - 0.5
+    };
+    let (mut hits, mut tri_hits) = (0, 0);
+    for _ in 0..4000 {
+        let p = vec3(next(), next(), 0.01 + 0.3 * next().abs());
+        let q = vec3(next(), next(), -0.01 - 0.3 * next().abs());
+        assert_eq!(quad.blocks(p, q), square.blocks(p, q), "{p:?} -> {q:?}");
+        assert_eq!(quad.reversed().blocks(p, q), square.blocks(p, q), "{p:?} -> {q:?}");
+        let d = q - p;
+        let x = p + d.scale(-p.z / d.z);
+        // Barycentric coordinates of x in ABC.
+        let area = |u: Vec3<f64>, v: Vec3<f64>, w: Vec3<f64>| (v - u).cross(w - u).z;
+        let (l1, l2, l3) = (area(x, b, c), area(a, x, c), area(a, b, x));
+        let total = area(a, b, c);
+        let inside = l1 > 0.0 && l2 > 0.0 && l3 > 0.0;
+        if l1.min(l2).min(l3).abs() > 1e-9 * total {
+            assert_eq!(triangle.blocks(p, q), inside, "{p:?} -> {q:?}");
+            assert_eq!(triangle.reversed().blocks(p, q), inside, "{p:?} -> {q:?}");
+        }
+        hits += usize::from(square.blocks(p, q));
+        tri_hits += usize::from(inside);
+    }
+    assert!(hits > 500 && tri_hits > 200, "{hits} {tri_hits}");
+    // From a point of its own plane, a segment does not cross it.
+    assert!(!triangle.blocks(vec3(0.5, 0.5, 0.0), vec3(0.5, 0.5, 1.0)));
+    #[cfg(feature = "closed-form")]
+    {
+        let tilted = Quadrilateral::new([
+            vec3(-1.0, -0.5, 0.3),
+            vec3(1.0, -0.1, 0.4),
+            vec3(0.8, 1.2, 0.6),
+            vec3(-1.3, 1.0, 0.5),
+        ]);
+        // Four corners of a plane: z = 0.3 + 0.05 (x + 1) + ... must be coplanar; build them so.
+        let plane = |x: f64, y: f64| vec3(x, y, 0.3 + 0.05 * x + 0.1 * y);
+        assert!(tilted.is_err(), "the corners above are not coplanar");
+        let tilted =
+            Quadrilateral::new([plane(-1.0, -0.5), plane(1.0, -0.1), plane(0.8, 1.2), plane(-1.3, 1.0)]).unwrap();
+        assert!(check_line_breaks(&tilted, 11) > 100);
+        let tri = Quadrilateral::triangle(plane(-1.0, -0.5), plane(1.2, 0.0), plane(0.0, 1.4)).unwrap();
+        assert!(check_line_breaks(&tri, 12) > 100);
+        assert!(check_line_breaks(&AnyOccluder::Quadrilateral(tri), 13) > 100);
+    }
+}
