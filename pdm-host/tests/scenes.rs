@@ -459,3 +459,27 @@ occludes = false
         assert_eq!(factor(&r, "away", b), 0.0, "away -> {b}");
     }
 }
+
+/// A row above 1 is flagged in any scene: two large plates over a small one, the nearer not
+/// an occluder, overlap in its view (F ≈ 0.9 + 0.8); with the nearer occluding, the farther is
+/// hidden and nothing is flagged.
+#[test]
+fn rows_above_one_are_flagged_in_open_scenes() {
+    let plates = |occludes: bool| {
+        format!(
+            "[[surface]]\nname = \"small\"\nkind = \"rectangle\"\norigin = [0, 0, 0]\nedge_t = [1, 0, 0]\nedge_s = [0, 1, 0]\n\n\
+             [[surface]]\nname = \"near\"\nkind = \"rectangle\"\norigin = [-4.5, -4.5, 1]\nedge_t = [0, 10, 0]\nedge_s = [10, 0, 0]\noccludes = {occludes}\n\n\
+             [[surface]]\nname = \"far\"\nkind = \"rectangle\"\norigin = [-4.5, -4.5, 2]\nedge_t = [0, 10, 0]\nedge_s = [10, 0, 0]\n"
+        )
+    };
+    let r = run(&scene(&plates(false)), PairMethod::Tolerance(1e-6));
+    let sum = r.surfaces.row_sums[index(&r, "small")];
+    assert!(sum > 1.5, "{sum}");
+    let flagged = &r.diagnostics.overfull_rows;
+    assert!(flagged.iter().any(|g| g.starts_with("surface small:")), "{flagged:?}");
+    assert!(pdm_host::scene::report::text(&r).contains("sum to more than 1"));
+    let r = run(&scene(&plates(true)), PairMethod::Tolerance(1e-6));
+    assert_eq!(factor(&r, "small", "far"), 0.0);
+    assert!(r.diagnostics.overfull_rows.is_empty(), "{:?}", r.diagnostics.overfull_rows);
+    assert!(pdm_host::scene::report::text(&r).contains("to space"));
+}

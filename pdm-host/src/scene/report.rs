@@ -56,6 +56,11 @@ pub struct Diagnostics {
     pub largest_reciprocity_residual: f64,
     /// Surfaces whose row misses 1 by more than its error estimate (enclosures only).
     pub enclosure_gaps: Vec<String>,
+    /// Surfaces and patches whose row sum exceeds 1 by more than its error estimate (any
+    /// scene): what leaves a surface cannot arrive more than once, so such a row means that
+    /// two surfaces overlap in its view (overlapping surfaces, or one with `occludes = false`
+    /// in front of another).
+    pub overfull_rows: Vec<String>,
     /// The slowest pairs.
     pub slowest: Vec<SlowPair>,
     /// Wall time (s).
@@ -67,6 +72,8 @@ pub struct Diagnostics {
 pub struct SceneReport {
     /// The length unit.
     pub units: String,
+    /// Whether the scene is declared an enclosure (otherwise 1 − row sum goes to space).
+    pub enclosure: bool,
     /// Surface-to-surface matrix.
     pub surfaces: Matrix,
     /// Patch-to-patch matrix.
@@ -181,6 +188,22 @@ pub fn assemble(scene: &Scene, result: &MatrixResult, method: PairMethod) -> Sce
             }
         }
     }
+    let mut overfull_rows = Vec::new();
+    for (level, matrix) in [("surface", &surfaces), ("patch", &patches)] {
+        for (i, &sum) in matrix.row_sums.iter().enumerate() {
+            let allowed = match &matrix.errors {
+                Some(e) => e[i].iter().sum::<f64>() + ENCLOSURE_SLACK,
+                None => 1e-6,
+            };
+            if sum - 1.0 > allowed {
+                overfull_rows.push(format!(
+                    "{level} {}: row sum {sum:.9} exceeds 1 by {:.2e} (estimate allows {allowed:.1e})",
+                    matrix.names[i],
+                    sum - 1.0
+                ));
+            }
+        }
+    }
     let mut slow: Vec<_> = result.pairs.iter().collect();
     slow.sort_by(|a, b| b.seconds.total_cmp(&a.seconds));
     let slowest = slow
@@ -201,10 +224,11 @@ pub fn assemble(scene: &Scene, result: &MatrixResult, method: PairMethod) -> Sce
         largest_relative_error,
         largest_reciprocity_residual: residual,
         enclosure_gaps,
+        overfull_rows,
         slowest,
         seconds: result.seconds,
     };
-    SceneReport { units: scene.units.clone(), surfaces, patches, diagnostics }
+    SceneReport { units: scene.units.clone(), enclosure: scene.enclosure, surfaces, patches, diagnostics }
 }
 
 /// The text summary: the surface matrix with row sums, then the diagnostics.
@@ -219,13 +243,17 @@ pub fn text(report: &SceneReport) -> String {
     for name in &s.names {
         out += &format!("  {name:>width$}");
     }
-    out += &format!("  {:>width$}\n", "row sum");
+    out += &format!("  {:>width$}", "row sum");
+    // An open scene: what leaves each surface and reaches none, 1 − row sum.
+    let open = !report.enclosure;
+    out += &if open { format!("  {:>width$}\n", "to space") } else { "\n".to_string() };
     for i in 0..s.names.len() {
         out += &format!("{:width$}  {:>12.6e}", s.names[i], s.areas[i]);
         for f in &s.factors[i] {
             out += &format!("  {f:>width$.10}");
         }
-        out += &format!("  {:>width$.10}\n", s.row_sums[i]);
+        out += &format!("  {:>width$.10}", s.row_sums[i]);
+        out += &if open { format!("  {:>width$.10}\n", 1.0 - s.row_sums[i]) } else { "\n".to_string() };
     }
     if let Some(errors) = &s.errors {
         out += "\nEstimated absolute error of each entry:\n";
@@ -256,6 +284,19 @@ pub fn text(report: &SceneReport) -> String {
                 (a leak, an overlap or a surface facing the wrong way):\n";
         for g in &d.enclosure_gaps {
             out += &format!("  {g}\n");
+        }
+    }
+    if !d.overfull_rows.is_empty() {
+        out += &format!(
+            "WARNING: {} rows sum to more than 1 beyond their estimates: surfaces overlap in their view \
+             (overlapping surfaces, or a surface with occludes = false in front of another):\n",
+            d.overfull_rows.len()
+        );
+        for g in d.overfull_rows.iter().take(10) {
+            out += &format!("  {g}\n");
+        }
+        if d.overfull_rows.len() > 10 {
+            out += &format!("  ... and {} more (all in the JSON output)\n", d.overfull_rows.len() - 10);
         }
     }
     for p in &d.slowest {
