@@ -187,6 +187,11 @@ struct Context<'s, T> {
     /// flat piece (computed once: a Bézier piece's concavity is sampled).
     piece_concave: Vec<Vec<bool>>,
     piece_planes: Vec<Vec<Option<Plane>>>,
+    /// Per surface and piece: the corners of a whole flat piece with straight edges (the
+    /// occluder's polygon, [`super::separate`]).
+    piece_polygons: Vec<Vec<Option<[Vec3<f64>; 4]>>>,
+    /// Per patch: its corners, if it has straight edges.
+    polygons: Vec<Option<[Vec3<f64>; 4]>>,
     /// Per surface: whether it stands for its entry's (or mesh group's) occluder, the first of
     /// the two sides that occludes.
     stands: Vec<bool>,
@@ -279,9 +284,18 @@ impl<T: Real> Context<'_, T> {
                     continue;
                 }
             }
-            for (occluder, plane) in self.occluders[k].iter().zip(&self.piece_planes[k]) {
+            for ((occluder, plane), polygon) in
+                self.occluders[k].iter().zip(&self.piece_planes[k]).zip(&self.piece_polygons[k])
+            {
                 if !occluder.may_block_between(bi, bj) {
                     continue;
+                }
+                // Flat polygons touching the pair's hull (a mesh's neighbours): a separating plane.
+                if let (Some(o), Some(a), Some(b)) = (polygon, &self.polygons[i], &self.polygons[j]) {
+                    let hull: Vec<_> = a.iter().chain(b).copied().collect();
+                    if super::separate::weakly_separated(&hull, o, self.tol) {
+                        continue;
+                    }
                 }
                 if let Some(plane) = plane {
                     let (lo_i, hi_i) = gi.distance_range(pi.rect, plane);
@@ -391,6 +405,12 @@ fn compute_with<T: Real, const CAP: usize>(
         .collect();
     let piece_concave = scene.surfaces.iter().map(|s| s.pieces.iter().map(|p| p.geom.concave()).collect()).collect();
     let piece_planes = scene.surfaces.iter().map(|s| s.pieces.iter().map(|p| p.geom.plane()).collect()).collect();
+    let piece_polygons = scene
+        .surfaces
+        .iter()
+        .map(|s| s.pieces.iter().map(|p| super::separate::polygon(&p.geom, p.geom.domain())).collect())
+        .collect();
+    let polygons = scene.patches.iter().map(|p| super::separate::polygon(scene.geom(p), p.rect)).collect();
     let mut ctx = Context {
         scene,
         shapes,
@@ -400,6 +420,8 @@ fn compute_with<T: Real, const CAP: usize>(
         planes: Vec::new(),
         piece_concave,
         piece_planes,
+        piece_polygons,
+        polygons,
         stands,
         tol: 0.0,
     };

@@ -12,6 +12,7 @@ pub mod matrix;
 pub mod mesh;
 pub mod model;
 pub mod report;
+pub mod separate;
 pub mod shape;
 
 use std::fmt;
