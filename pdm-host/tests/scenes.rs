@@ -483,3 +483,39 @@ fn rows_above_one_are_flagged_in_open_scenes() {
     assert!(r.diagnostics.overfull_rows.is_empty(), "{:?}", r.diagnostics.overfull_rows);
     assert!(pdm_host::scene::report::text(&r).contains("to space"));
 }
+
+/// The NumPy outputs read back: the .npz's arrays (names, areas, factors, row sums, errors at
+/// both levels) equal the report's; the .npy is the surface matrix.
+#[test]
+fn numpy_outputs_read_back() {
+    use std::io::Read as _;
+    let s = scene(CUBE);
+    let r = run(&s, PairMethod::Tolerance(1e-6));
+    let bytes = pdm_host::scene::report::encode(&r, std::path::Path::new("x.npz")).unwrap();
+    let mut archive = zip::ZipArchive::new(std::io::Cursor::new(bytes)).unwrap();
+    let mut read = |name: &str| {
+        let mut file = archive.by_name(&format!("{name}.npy")).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let mut data = Vec::new();
+        file.read_to_end(&mut data).unwrap();
+        npyz::NpyFile::new(std::io::Cursor::new(data)).unwrap()
+    };
+    for (level, m) in [("surface", &r.surfaces), ("patch", &r.patches)] {
+        let n = m.names.len() as u64;
+        let names = read(&format!("{level}_names"));
+        assert_eq!(names.shape(), &[n]);
+        assert_eq!(names.into_vec::<String>().unwrap(), m.names);
+        assert_eq!(read(&format!("{level}_areas")).into_vec::<f64>().unwrap(), m.areas);
+        let factors = read(&format!("{level}_factors"));
+        assert_eq!(factors.shape(), &[n, n]);
+        assert_eq!(factors.into_vec::<f64>().unwrap(), m.factors.concat());
+        assert_eq!(read(&format!("{level}_row_sums")).into_vec::<f64>().unwrap(), m.row_sums);
+        let errors = read(&format!("{level}_errors")).into_vec::<f64>().unwrap();
+        assert_eq!(errors, m.errors.as_ref().unwrap().concat());
+    }
+    let npy = pdm_host::scene::report::encode(&r, std::path::Path::new("x.npy")).unwrap();
+    let matrix = npyz::NpyFile::new(&npy[..]).unwrap();
+    assert_eq!(matrix.shape(), &[6, 6]);
+    assert_eq!(matrix.into_vec::<f64>().unwrap(), r.surfaces.factors.concat());
+    let e = pdm_host::scene::report::encode(&r, std::path::Path::new("x.mat")).unwrap_err();
+    assert!(e.contains(".npz"), "{e}");
+}

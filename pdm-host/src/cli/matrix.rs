@@ -36,8 +36,10 @@ pub struct MatrixArgs {
     /// Floating-point width of the computation.
     #[arg(long, value_enum, default_value_t = Precision::F64)]
     pub precision: Precision,
-    /// Write the matrices: .csv (one row per nonzero entry, surfaces then patches) or .json
-    /// (names, areas, both matrices, error estimates, diagnostics). Written atomically.
+    /// Write the matrices: .csv (one row per nonzero entry, surfaces then patches), .json
+    /// (names, areas, both matrices, error estimates, diagnostics), .npz (NumPy: names, areas,
+    /// matrices, row sums, error estimates per level) or .npy (the surface matrix alone).
+    /// Written atomically.
     #[arg(long, value_name = "FILE")]
     pub output: Option<PathBuf>,
     /// Compute only slice K of N of the pairs (1 <= K <= N), for running the slices as a job

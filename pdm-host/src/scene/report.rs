@@ -341,6 +341,66 @@ pub fn csv(report: &SceneReport) -> Result<Vec<u8>, csv::Error> {
     w.into_inner().map_err(|e| csv::Error::from(e.into_error()))
 }
 
+/// One array of the NumPy output: its name in the `.npz` archive and its `.npy` bytes.
+type NpyArray = (String, Vec<u8>);
+
+/// An `.npy` file of `values` in row-major order with the given shape (`<f8`).
+fn npy_f64(shape: &[u64], values: impl IntoIterator<Item = f64>) -> std::io::Result<Vec<u8>> {
+    use npyz::WriterBuilder as _;
+    let mut out = Vec::new();
+    let mut w = npyz::WriteOptions::<f64>::new().default_dtype().shape(shape).writer(&mut out).begin_nd()?;
+    w.extend(values)?;
+    w.finish()?;
+    Ok(out)
+}
+
+/// An `.npy` file of strings (`<U{longest}`, NumPy's fixed-width unicode).
+fn npy_strings(values: &[String]) -> std::io::Result<Vec<u8>> {
+    use npyz::WriterBuilder as _;
+    let width = values.iter().map(|v| v.chars().count()).max().unwrap_or(0).max(1);
+    let dtype = npyz::DType::Plain(
+        format!("<U{width}").parse().map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidInput, e))?,
+    );
+    let mut out = Vec::new();
+    let mut w =
+        npyz::WriteOptions::<str>::new().dtype(dtype).shape(&[values.len() as u64]).writer(&mut out).begin_nd()?;
+    for v in values {
+        w.push(v.as_str())?;
+    }
+    w.finish()?;
+    Ok(out)
+}
+
+/// The arrays of the NumPy output: per level (`surface_`, `patch_`) the names, areas, the
+/// factor matrix, its row sums and (tolerance mode) the error estimates.
+fn npy_arrays(report: &SceneReport) -> std::io::Result<Vec<NpyArray>> {
+    let mut arrays = Vec::new();
+    for (level, m) in [("surface", &report.surfaces), ("patch", &report.patches)] {
+        let n = m.names.len() as u64;
+        arrays.push((format!("{level}_names"), npy_strings(&m.names)?));
+        arrays.push((format!("{level}_areas"), npy_f64(&[n], m.areas.iter().copied())?));
+        arrays.push((format!("{level}_factors"), npy_f64(&[n, n], m.factors.iter().flatten().copied())?));
+        arrays.push((format!("{level}_row_sums"), npy_f64(&[n], m.row_sums.iter().copied())?));
+        if let Some(e) = &m.errors {
+            arrays.push((format!("{level}_errors"), npy_f64(&[n, n], e.iter().flatten().copied())?));
+        }
+    }
+    Ok(arrays)
+}
+
+/// The NumPy archive (`numpy.load("x.npz")`): every array of [`npy_arrays`] as `NAME.npy`,
+/// deflated.
+fn npz(report: &SceneReport) -> Result<Vec<u8>, String> {
+    let arrays = npy_arrays(report).map_err(|e| e.to_string())?;
+    let mut zip = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
+    let options = zip::write::SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
+    for (name, bytes) in arrays {
+        zip.start_file(format!("{name}.npy"), options).map_err(|e| e.to_string())?;
+        zip.write_all(&bytes).map_err(|e| e.to_string())?;
+    }
+    Ok(zip.finish().map_err(|e| e.to_string())?.into_inner())
+}
+
 /// Writes `bytes` to `path` atomically: a temporary file in the same folder, renamed into place
 /// (an interrupted or failed run leaves no half-written file).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
@@ -355,11 +415,20 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     Ok(())
 }
 
-/// The output's bytes by the file's extension: `.csv` long-form CSV, `.json` the whole report.
+/// The output's bytes by the file's extension: `.csv` long-form CSV, `.json` the whole report,
+/// `.npy` the surface-to-surface factor matrix, `.npz` every matrix with names, areas, row
+/// sums and error estimates ([`npy_arrays`]).
 pub fn encode(report: &SceneReport, path: &Path) -> Result<Vec<u8>, String> {
     match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
         Some("csv") => csv(report).map_err(|e| e.to_string()),
         Some("json") => serde_json::to_vec_pretty(report).map_err(|e| e.to_string()),
-        other => Err(format!("unknown output format {:?} (use .csv or .json)", other.unwrap_or(""))),
+        // One array: the surface-to-surface factors (the .npz holds everything).
+        Some("npy") => {
+            let m = &report.surfaces;
+            let n = m.names.len() as u64;
+            npy_f64(&[n, n], m.factors.iter().flatten().copied()).map_err(|e| e.to_string())
+        }
+        Some("npz") => npz(report),
+        other => Err(format!("unknown output format {:?} (use .csv, .json, .npy or .npz)", other.unwrap_or(""))),
     }
 }
