@@ -35,6 +35,16 @@ fn writes_json_and_csv_atomically() {
     let text = std::fs::read_to_string(&csv).unwrap();
     assert!(text.starts_with("level,from,to,area_from,factor,error\nsurface,floor,ceiling,"), "{text}");
     assert_eq!(text.lines().filter(|l| l.starts_with("surface,")).count(), 30);
+
+    // NumPy: an .npz archive (a zip of .npy files) and a bare .npy of the surface matrix.
+    for name in ["cube.npz", "cube.NPY"] {
+        let path = dir.path().join(name);
+        let out = pdm(&["matrix", &example("cube.toml"), "--order", "6", "--output", path.to_str().unwrap()]);
+        assert!(out.status.success(), "{name}: {}", String::from_utf8_lossy(&out.stderr));
+        let bytes = std::fs::read(&path).unwrap();
+        let magic: &[u8] = if name.ends_with("npz") { b"PK" } else { b"\x93NUMPY" };
+        assert!(bytes.starts_with(magic), "{name}");
+    }
 }
 
 #[test]

@@ -70,7 +70,8 @@ pub struct MergeArgs {
 }
 
 fn output_format_ok(out: &std::path::Path) -> bool {
-    matches!(out.extension().and_then(|e| e.to_str()), Some("csv" | "json"))
+    let ext = out.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    matches!(ext.as_deref(), Some("csv" | "json" | "npy" | "npz"))
 }
 
 fn write_report(report: &report::SceneReport, out: &std::path::Path) -> ExitCode {
@@ -88,7 +89,7 @@ fn write_report(report: &report::SceneReport, out: &std::path::Path) -> ExitCode
 pub fn run_merge(args: &MergeArgs) -> ExitCode {
     if let Some(out) = &args.output {
         if !output_format_ok(out) {
-            eprintln!("error: --output {}: unknown format (use a .csv or .json file name)", out.display());
+            eprintln!("error: --output {}: unknown format (use a .csv, .json, .npy or .npz file name)", out.display());
             return ExitCode::from(EXIT_USAGE);
         }
     }
@@ -150,7 +151,7 @@ pub fn run(args: &MatrixArgs) -> ExitCode {
     };
     if let Some(out) = &args.output {
         if !output_format_ok(out) {
-            eprintln!("error: --output {}: unknown format (use a .csv or .json file name)", out.display());
+            eprintln!("error: --output {}: unknown format (use a .csv, .json, .npy or .npz file name)", out.display());
             return ExitCode::from(EXIT_USAGE);
         }
         if args.shard.is_some() && out.extension().and_then(|e| e.to_str()) != Some("json") {
