@@ -355,8 +355,7 @@ fn single_precision_matches_to_its_resolution() {
 }
 
 /// The unit cube from an OBJ file (one object per face, 12 triangles) against C-11 and C-14:
-/// opposite faces exact; adjacent faces whose triangles meet at their collapsed corners
-/// converge slowly in the touching transforms, and there the estimate must cover the error.
+/// every facet pair by the contour form, exact to rounding.
 #[test]
 fn obj_cube_against_c11_and_c14() {
     let path = format!("{}/../examples/scenes/cube_obj.toml", env!("CARGO_MANIFEST_DIR"));
@@ -518,4 +517,26 @@ fn numpy_outputs_read_back() {
     assert_eq!(matrix.into_vec::<f64>().unwrap(), r.surfaces.factors.concat());
     let e = pdm_host::scene::report::encode(&r, std::path::Path::new("x.mat")).unwrap_err();
     assert!(e.contains(".npz"), "{e}");
+}
+
+/// OBJ faces: a flat convex quad stays one facet (a square under a parallel rectangle: C-11),
+/// a bent quad is cut into two triangles, a face of two vertices is a named error.
+#[test]
+fn obj_quads_stay_whole_and_bent_quads_are_cut() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = "v 0 0 0\nv 2 0 0\nv 2 2 0\nv 0 2 0\nv 0 0 5\nv 2 0 5\nv 2 2 5.5\nv 0 2 5\n\
+               o square\nf 1 2 3 4\no bent\nf 5 8 7 6\n";
+    std::fs::write(dir.path().join("m.obj"), obj).unwrap();
+    let text = "[[surface]]\nname = \"m\"\nkind = \"mesh\"\nfile = \"m.obj\"\n\n\
+                [[surface]]\nname = \"top\"\nkind = \"rectangle\"\norigin = [0, 0, 1]\nedge_t = [0, 2, 0]\nedge_s = [2, 0, 0]\noccludes = false\n";
+    let path = dir.path().join("scene.toml");
+    std::fs::write(&path, text).unwrap();
+    let s = pdm_host::scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    let pieces = |name: &str| s.surfaces.iter().find(|x| x.name == name).unwrap().pieces.len();
+    assert_eq!((pieces("m/square"), pieces("m/bent")), (1, 2));
+    let r = run(&s, PairMethod::Tolerance(1e-10));
+    check(&r, "m/square", "top", closed_form::parallel_rectangles(2.0, 2.0, 1.0), 1e-10); // C-11
+    std::fs::write(dir.path().join("m.obj"), "v 0 0 0\nv 1 0 0\nf 1 2\n").unwrap();
+    let e = pdm_host::scene::load(&path).unwrap_err().to_string();
+    assert!(e.contains("field `file`") && e.contains("face 1 has 2 vertices"), "{e}");
 }

@@ -324,29 +324,38 @@ fn geometry(i: usize, spec: &SurfaceSpec, flip: bool, place: &Place, base: &Path
             };
             let several = groups.len() > 1;
             let mut out = Vec::new();
-            for (group, triangles) in groups {
+            for (group, polygons) in groups {
                 let mut pieces = Vec::new();
-                for (k, t) in triangles.iter().enumerate() {
-                    if t.iter().any(|p| !p.is_finite()) {
+                for (k, polygon) in polygons.iter().enumerate() {
+                    if polygon.iter().any(|p| !p.is_finite()) {
                         return fail(
                             i,
                             spec,
                             "file",
-                            format!("{}: facet {} has a non-finite vertex", path.display(), k + 1),
+                            format!("{}: face {} has a non-finite vertex", path.display(), k + 1),
                         );
                     }
-                    let [a, b, c] = t.map(|p| place.point(p));
-                    let corners = [a, b, c, a];
-                    if let Err(problem) = super::mesh::check_polygon(&corners) {
+                    if polygon.len() < 3 {
                         return fail(
                             i,
                             spec,
                             "file",
-                            format!("{}: facet {} ({group}): {problem}", path.display(), k + 1),
+                            format!("{}: face {} has {} vertices", path.display(), k + 1, polygon.len()),
                         );
                     }
-                    let g = Geom::Quadrilateral { corners: if flip { reversed(corners) } else { corners } };
-                    pieces.push((g, g.domain()));
+                    let placed: Vec<_> = polygon.iter().map(|p| place.point(*p)).collect();
+                    for corners in super::mesh::facets(&placed) {
+                        if let Err(problem) = super::mesh::check_polygon(&corners) {
+                            return fail(
+                                i,
+                                spec,
+                                "file",
+                                format!("{}: face {} ({group}): {problem}", path.display(), k + 1),
+                            );
+                        }
+                        let g = Geom::Quadrilateral { corners: if flip { reversed(corners) } else { corners } };
+                        pieces.push((g, g.domain()));
+                    }
                 }
                 out.push((if several { format!("/{group}") } else { String::new() }, pieces));
             }

@@ -1,6 +1,7 @@
-//! Flat facets from mesh files: OBJ (`tobj`, in f64, every face triangulated, one group per OBJ
-//! object or group) and STL (`stl_io`, ASCII or binary, one group). Each triangle A B C becomes
-//! the kernel's `Quadrilateral` A B C A, g(t, s) = A + t·(B − A + s·(C − B)), whose normal
+//! Flat facets from mesh files: OBJ (`tobj`, in f64, one group per OBJ object or group) and STL
+//! (`stl_io`, ASCII or binary, one group). A flat convex quadrilateral face stays one facet,
+//! the kernel's `Quadrilateral`; any other face is cut into triangles, each triangle A B C
+//! the `Quadrilateral` A B C A, g(t, s) = A + t·(B − A + s·(C − B)), whose normal
 //! t·(B − A) × (C − A) points to the side the vertices turn counter-clockwise around: a flat
 //! facet with straight edges, so facet pairs that see each other wholly take the contour form
 //! in closed form, and an exact occluder.
@@ -9,36 +10,69 @@ use std::path::Path;
 
 use pdm_kernel::{vec3, Vec3};
 
-/// A triangle's vertices.
-pub type Triangle = [Vec3<f64>; 3];
+/// A facet: the corners of a flat convex quadrilateral, a triangle repeating its first.
+pub type Facet = [Vec3<f64>; 4];
 
-/// The facets of a mesh file by group: (group name, triangles).
-pub fn load(path: &Path) -> Result<Vec<(String, Vec<Triangle>)>, String> {
+/// The OBJ faces of a model as polygons (their vertex lists, in order).
+fn obj_polygons(path: &Path, model: &tobj::Model) -> Result<Vec<Vec<Vec3<f64>>>, String> {
+    let p = &model.mesh.positions;
+    let vertex = |k: u32| -> Result<Vec3<f64>, String> {
+        let k = k as usize * 3;
+        match (p.get(k), p.get(k + 1), p.get(k + 2)) {
+            (Some(&x), Some(&y), Some(&z)) => Ok(vec3(x, y, z)),
+            _ => Err(format!("{}: object {}: a face refers to a missing vertex", path.display(), model.name)),
+        }
+    };
+    let indices = &model.mesh.indices;
+    // No arities: every face is a triangle.
+    let arities: Vec<usize> = if model.mesh.face_arities.is_empty() {
+        vec![3; indices.len() / 3]
+    } else {
+        model.mesh.face_arities.iter().map(|&a| a as usize).collect()
+    };
+    let mut polygons = Vec::with_capacity(arities.len());
+    let mut start = 0usize;
+    for arity in arities {
+        let face = indices
+            .get(start..start + arity)
+            .ok_or_else(|| format!("{}: object {}: a face refers to a missing vertex", path.display(), model.name))?;
+        polygons.push(face.iter().map(|&k| vertex(k)).collect::<Result<Vec<_>, _>>()?);
+        start += arity;
+    }
+    Ok(polygons)
+}
+
+/// A face as facets: a flat convex quadrilateral stays one (a parallelogram then has an affine
+/// map, which the kernel's occluded paths use); any other polygon is cut into the fan of
+/// triangles from its first vertex (as OBJ readers triangulate).
+#[must_use]
+pub fn facets(polygon: &[Vec3<f64>]) -> Vec<Facet> {
+    if let [a, b, c, d] = *polygon {
+        if check_polygon(&[a, b, c, d]).is_ok() {
+            return vec![[a, b, c, d]];
+        }
+    }
+    match polygon.split_first() {
+        Some((&a, rest)) => rest.windows(2).map(|w| [a, w[0], w[1], a]).collect(),
+        None => Vec::new(),
+    }
+}
+
+/// A mesh file's faces by group: (group name, each face's vertices in order).
+pub type Groups = Vec<(String, Vec<Vec<Vec3<f64>>>)>;
+
+/// The faces of a mesh file by group, as given (see [`facets`] for what they become).
+pub fn load(path: &Path) -> Result<Groups, String> {
     let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
     match ext.as_deref() {
         Some("obj") => {
-            let options = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
+            let options = tobj::LoadOptions { triangulate: false, single_index: true, ..Default::default() };
             let (models, _) = tobj::load_obj(path, &options).map_err(|e| format!("{}: {e}", path.display()))?;
             let mut groups = Vec::new();
             for model in models {
-                let p = &model.mesh.positions;
-                let vertex = |k: u32| -> Result<Vec3<f64>, String> {
-                    let k = k as usize * 3;
-                    match (p.get(k), p.get(k + 1), p.get(k + 2)) {
-                        (Some(&x), Some(&y), Some(&z)) => Ok(vec3(x, y, z)),
-                        _ => {
-                            Err(format!("{}: object {}: a face refers to a missing vertex", path.display(), model.name))
-                        }
-                    }
-                };
-                let mut triangles = Vec::new();
-                for face in model.mesh.indices.chunks(3) {
-                    if let [a, b, c] = *face {
-                        triangles.push([vertex(a)?, vertex(b)?, vertex(c)?]);
-                    }
-                }
-                if !triangles.is_empty() {
-                    groups.push((model.name.clone(), triangles));
+                let polygons = obj_polygons(path, &model)?;
+                if !polygons.is_empty() {
+                    groups.push((model.name.clone(), polygons));
                 }
             }
             Ok(groups)
@@ -55,7 +89,7 @@ pub fn load(path: &Path) -> Result<Vec<(String, Vec<Triangle>)>, String> {
             let triangles = mesh
                 .faces
                 .iter()
-                .map(|f| Ok([v(f.vertices[0])?, v(f.vertices[1])?, v(f.vertices[2])?]))
+                .map(|f| Ok(vec![v(f.vertices[0])?, v(f.vertices[1])?, v(f.vertices[2])?]))
                 .collect::<Result<Vec<_>, String>>()?;
             Ok(vec![(String::new(), triangles)])
         }

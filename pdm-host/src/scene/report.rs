@@ -417,7 +417,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
 
 /// The output's bytes by the file's extension: `.csv` long-form CSV, `.json` the whole report,
 /// `.npy` the surface-to-surface factor matrix, `.npz` every matrix with names, areas, row
-/// sums and error estimates ([`npy_arrays`]).
+/// sums and error estimates, as `surface_*` and `patch_*` arrays (SCENES.md).
 pub fn encode(report: &SceneReport, path: &Path) -> Result<Vec<u8>, String> {
     match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
         Some("csv") => csv(report).map_err(|e| e.to_string()),

@@ -35,6 +35,9 @@ pub struct Quadrilateral<T> {
     pub(crate) corners: [Vec3<T>; 4],
     /// Twice the area vector, (P₂ − P₀) × (P₃ − P₁): the plane's normal, to the radiating side.
     pub(crate) normal: Vec3<T>,
+    /// Whether the corners make a parallelogram (P₂ = P₁ + P₃ − P₀ to rounding): the map is
+    /// then affine ([`Surface::affine_map`]).
+    pub(crate) parallelogram: bool,
 }
 
 impl<T: Real> Quadrilateral<T> {
@@ -73,7 +76,9 @@ impl<T: Real> Quadrilateral<T> {
                 return Err(PdmError::Degenerate);
             }
         }
-        Ok(Self { corners, normal })
+        let twist = (p2 - p1 - p3 + p0).norm();
+        let parallelogram = twist <= T::from_f64(16.0) * T::EPSILON * size;
+        Ok(Self { corners, normal, parallelogram })
     }
 
     /// The triangle ABC (the quadrilateral A B C A), radiating to the side about which A, B, C
@@ -98,7 +103,7 @@ impl<T: Real> Quadrilateral<T> {
     #[must_use]
     pub fn reversed(&self) -> Self {
         let [p0, p1, p2, p3] = self.corners;
-        Self { corners: [p0, p3, p2, p1], normal: -self.normal }
+        Self { corners: [p0, p3, p2, p1], normal: -self.normal, parallelogram: self.parallelogram }
     }
 
     /// ∂g/∂t and ∂g/∂s at (t, s).
@@ -138,6 +143,13 @@ impl<T: Real> Surface<T> for Quadrilateral<T> {
     fn normal(&self, t: T, s: T) -> Vec3<T> {
         let (gt, gs) = self.partials(t, s);
         gt.cross(gs)
+    }
+    /// A parallelogram's map is affine (the bilinear term's coefficient P₂ − P₁ − P₃ + P₀
+    /// vanishes); other quadrilaterals and triangles have none.
+    #[cfg(feature = "closed-form")]
+    fn affine_map(&self) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {
+        let [p0, p1, _, p3] = self.corners;
+        self.parallelogram.then_some((p0, p1 - p0, p3 - p0))
     }
     #[cfg(feature = "closed-form")]
     fn point_and_partials(&self, t: T, s: T) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {
@@ -202,6 +214,15 @@ mod tests {
             Err(PdmError::Degenerate)
         );
         assert_eq!(Quadrilateral::new([o, x, y, vec3(1.0, 1.0, 0.0)]), Err(PdmError::Degenerate));
-        assert!(Quadrilateral::new([o, x, vec3(1.0, 1.0, 0.0), y]).is_ok());
+        let square = Quadrilateral::new([o, x, vec3(1.0, 1.0, 0.0), y]).unwrap();
+        // A parallelogram has an affine map (the bilinear term vanishes), others none.
+        #[cfg(feature = "closed-form")]
+        {
+            assert_eq!(square.affine_map(), Some((o, x, y)));
+            assert_eq!(square.reversed().affine_map(), Some((o, y, x)));
+            assert!(Quadrilateral::new([o, x, vec3(1.2, 1.0, 0.0), y]).unwrap().affine_map().is_none());
+            assert!(Quadrilateral::triangle(o, x, y).unwrap().affine_map().is_none());
+        }
+        let _ = square;
     }
 }
