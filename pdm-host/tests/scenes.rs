@@ -377,18 +377,25 @@ fn obj_cube_against_c11_and_c14() {
     }
 }
 
+/// A temporary folder holding `scene.toml` and one mesh file (name, contents); the folder
+/// lives as long as the returned guard.
+fn scene_folder(scene_text: &str, (name, mesh): (&str, &str)) -> (tempfile::TempDir, std::path::PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join(name), mesh).unwrap();
+    let path = dir.path().join("scene.toml");
+    std::fs::write(&path, scene_text).unwrap();
+    (dir, path)
+}
+
 /// An STL file (ASCII; two triangles making a 2 × 2 square, facing up) under a parallel
 /// rectangle: C-11. Facets radiate to the counter-clockwise side.
 #[test]
 fn stl_square_under_a_rectangle() {
-    let dir = tempfile::tempdir().unwrap();
     let stl = "solid sq\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 2 0 0\nvertex 2 2 0\nendloop\nendfacet\n\
                facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 2 2 0\nvertex 0 2 0\nendloop\nendfacet\nendsolid sq\n";
-    std::fs::write(dir.path().join("sq.stl"), stl).unwrap();
     let scene_text = "[[surface]]\nname = \"square\"\nkind = \"mesh\"\nfile = \"sq.stl\"\n\n\
                       [[surface]]\nname = \"top\"\nkind = \"rectangle\"\norigin = [0, 0, 1]\nedge_t = [0, 2, 0]\nedge_s = [2, 0, 0]\n";
-    let path = dir.path().join("scene.toml");
-    std::fs::write(&path, scene_text).unwrap();
+    let (dir, path) = scene_folder(scene_text, ("sq.stl", stl));
     let s = pdm_host::scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
     let r = run(&s, PairMethod::Tolerance(1e-9));
     check(&r, "square", "top", closed_form::parallel_rectangles(2.0, 2.0, 1.0), 1e-9); // C-11
@@ -523,14 +530,11 @@ fn numpy_outputs_read_back() {
 /// a bent quad is cut into two triangles, a face of two vertices is a named error.
 #[test]
 fn obj_quads_stay_whole_and_bent_quads_are_cut() {
-    let dir = tempfile::tempdir().unwrap();
     let obj = "v 0 0 0\nv 2 0 0\nv 2 2 0\nv 0 2 0\nv 0 0 5\nv 2 0 5\nv 2 2 5.5\nv 0 2 5\n\
                o square\nf 1 2 3 4\no bent\nf 5 8 7 6\n";
-    std::fs::write(dir.path().join("m.obj"), obj).unwrap();
     let text = "[[surface]]\nname = \"m\"\nkind = \"mesh\"\nfile = \"m.obj\"\n\n\
                 [[surface]]\nname = \"top\"\nkind = \"rectangle\"\norigin = [0, 0, 1]\nedge_t = [0, 2, 0]\nedge_s = [2, 0, 0]\noccludes = false\n";
-    let path = dir.path().join("scene.toml");
-    std::fs::write(&path, text).unwrap();
+    let (dir, path) = scene_folder(text, ("m.obj", obj));
     let s = pdm_host::scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
     let pieces = |name: &str| s.surfaces.iter().find(|x| x.name == name).unwrap().pieces.len();
     assert_eq!((pieces("m/square"), pieces("m/bent")), (1, 2));

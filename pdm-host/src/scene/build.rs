@@ -462,17 +462,9 @@ pub fn build_in(file: &SceneFile, base: &Path) -> Result<Scene, EntryError> {
                 for (geom, rect) in list {
                     let grid =
                         match (spec.subdivide, spec.patch_size) {
-                            // A flipped Bézier net is transposed: its grid too, so that its cells are
-                            // the front's.
-                            (Some([m, n]), _)
-                                if flip
-                                    && matches!(
-                                        spec.kind,
-                                        Kind::Bezier | Kind::Mesh | Kind::Triangle | Kind::Quadrilateral
-                                    ) =>
-                            {
-                                (n, m)
-                            }
+                            // A flipped Bézier net or facet is transposed: its grid too, so that its
+                            // cells are the front's.
+                            (Some([m, n]), _) if flip && spec.kind.flips_by_transpose() => (n, m),
                             (Some([m, n]), _) => (m, n),
                             (None, Some(size)) => {
                                 let count = |along_t| (mid_length(&geom, rect, along_t) / size).ceil().max(1.0);

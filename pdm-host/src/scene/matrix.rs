@@ -260,6 +260,8 @@ impl<T: Real> Context<'_, T> {
         }
         let (bi, bj) = (&self.info[i].ball, &self.info[j].ball);
         let mut list = Vec::new();
+        // The two patches' hull, built when a flat occluder first needs it.
+        let mut hull = None;
         for (k, s) in scene.surfaces.iter().enumerate() {
             if !self.stands[k] {
                 continue;
@@ -290,17 +292,17 @@ impl<T: Real> Context<'_, T> {
                 if !occluder.may_block_between(bi, bj) {
                     continue;
                 }
-                // Flat polygons touching the pair's hull (a mesh's neighbours): a separating plane.
-                if let (Some(o), Some(a), Some(b)) = (polygon, &self.polygons[i], &self.polygons[j]) {
-                    let hull: Vec<_> = a.iter().chain(b).copied().collect();
-                    if super::separate::weakly_separated(&hull, o, self.tol) {
-                        continue;
-                    }
-                }
                 if let Some(plane) = plane {
                     let (lo_i, hi_i) = gi.distance_range(pi.rect, plane);
                     let (lo_j, hi_j) = gj.distance_range(pj.rect, plane);
                     if (lo_i >= -self.tol && lo_j >= -self.tol) || (hi_i <= self.tol && hi_j <= self.tol) {
+                        continue;
+                    }
+                }
+                // Flat polygons touching the pair's hull (a mesh's neighbours): a separating plane.
+                if let (Some(o), Some(a), Some(b)) = (polygon, &self.polygons[i], &self.polygons[j]) {
+                    let hull = hull.get_or_insert_with(|| super::separate::Hull::new(&[*a, *b].concat()));
+                    if hull.weakly_separated_from(o, self.tol) {
                         continue;
                     }
                 }

@@ -69,6 +69,13 @@ impl Kind {
         }
     }
 
+    /// Whether the other side of an entry is its map with t and s swapped (Bézier nets, facets),
+    /// so that a `subdivide` grid is transposed with it.
+    #[must_use]
+    pub fn flips_by_transpose(self) -> bool {
+        matches!(self, Self::Bezier | Self::Mesh | Self::Triangle | Self::Quadrilateral)
+    }
+
     /// Whether the surface bounds a solid (sphere, tube, cone): its sides are `outer` and
     /// `inner`; the others are open sheets with `front` and `back`.
     #[must_use]

@@ -33,58 +33,68 @@ pub fn polygon(geom: &Geom, rect: Rect) -> Option<[Vec3<f64>; 4]> {
     }
 }
 
+/// The differences between the points (zero ones left out): every edge of their convex hull
+/// is one of them.
+fn differences(points: &[Vec3<f64>]) -> Vec<Vec3<f64>> {
+    let mut d = Vec::new();
+    for (k, x) in points.iter().enumerate() {
+        for y in &points[k + 1..] {
+            let e = *y - *x;
+            if e.norm2() > 0.0 {
+                d.push(e);
+            }
+        }
+    }
+    d
+}
+
+/// The convex hull P of a pair's two patches, by its points and the candidates for its
+/// edges: built once per pair, tested against each flat occluder that survives the cheaper
+/// tests.
+pub struct Hull {
+    points: Vec<Vec3<f64>>,
+    edges: Vec<Vec3<f64>>,
+}
+
+impl Hull {
+    /// The hull of the given points.
+    #[must_use]
+    pub fn new(points: &[Vec3<f64>]) -> Self {
+        Self { points: points.to_vec(), edges: differences(points) }
+    }
+
+    /// `true` if some plane has the hull on one closed side and all of `o` on the other, to
+    /// within `tol` (a length): they do not overlap (they may touch).
+    #[must_use]
+    pub fn weakly_separated_from(&self, o: &[Vec3<f64>], tol: f64) -> bool {
+        let separates = |n: Vec3<f64>| {
+            let length = n.norm();
+            if !(length > 0.0) || !length.is_finite() {
+                return false;
+            }
+            let range = |points: &[Vec3<f64>]| {
+                points
+                    .iter()
+                    .map(|x| n.dot(*x) / length)
+                    .fold((f64::MAX, -f64::MAX), |(lo, hi), d| (lo.min(d), hi.max(d)))
+            };
+            let ((p_lo, p_hi), (o_lo, o_hi)) = (range(&self.points), range(o));
+            p_hi <= o_lo + tol || o_hi <= p_lo + tol
+        };
+        let (pe, oe) = (&self.edges, differences(o));
+        // O's plane (and, for degenerate O, its edges' cross products), then the edge–edge
+        // planes, then P's faces.
+        let pairs_within =
+            |e: &[Vec3<f64>]| e.iter().enumerate().any(|(k, x)| e[k + 1..].iter().any(|y| separates(x.cross(*y))));
+        pairs_within(&oe) || pe.iter().any(|x| oe.iter().any(|y| separates(x.cross(*y)))) || pairs_within(pe)
+    }
+}
+
 /// `true` if some plane has all of `p` on one closed side and all of `o` on the other, to
 /// within `tol` (a length): conv(p) and conv(o) do not overlap (they may touch).
 #[must_use]
 pub fn weakly_separated(p: &[Vec3<f64>], o: &[Vec3<f64>], tol: f64) -> bool {
-    let separates = |n: Vec3<f64>| {
-        let length = n.norm();
-        if !(length > 0.0) || !length.is_finite() {
-            return false;
-        }
-        let range = |points: &[Vec3<f64>]| {
-            points.iter().map(|x| n.dot(*x) / length).fold((f64::MAX, -f64::MAX), |(lo, hi), d| (lo.min(d), hi.max(d)))
-        };
-        let ((p_lo, p_hi), (o_lo, o_hi)) = (range(p), range(o));
-        p_hi <= o_lo + tol || o_hi <= p_lo + tol
-    };
-    // Edges of conv(p) are differences of its points; O's edges likewise.
-    let differences = |points: &[Vec3<f64>]| -> Vec<Vec3<f64>> {
-        let mut d = Vec::new();
-        for (k, x) in points.iter().enumerate() {
-            for y in &points[k + 1..] {
-                let e = *y - *x;
-                if e.norm2() > 0.0 {
-                    d.push(e);
-                }
-            }
-        }
-        d
-    };
-    let (pe, oe) = (differences(p), differences(o));
-    // O's plane (and, for degenerate O, its edges' cross products).
-    for (k, x) in oe.iter().enumerate() {
-        for y in &oe[k + 1..] {
-            if separates(x.cross(*y)) {
-                return true;
-            }
-        }
-    }
-    for x in &pe {
-        for y in &oe {
-            if separates(x.cross(*y)) {
-                return true;
-            }
-        }
-    }
-    for (k, x) in pe.iter().enumerate() {
-        for y in &pe[k + 1..] {
-            if separates(x.cross(*y)) {
-                return true;
-            }
-        }
-    }
-    false
+    Hull::new(p).weakly_separated_from(o, tol)
 }
 
 #[cfg(test)]

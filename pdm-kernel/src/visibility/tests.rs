@@ -454,11 +454,9 @@ fn quadrilateral_and_triangle_block_as_their_outlines() {
     let quad = Quadrilateral::new([o_, o_ + et, o_ + et + es, o_ + es]).unwrap();
     let (a, b, c) = (vec3(0.0, 0.0, 0.0), vec3(2.0, 0.2, 0.0), vec3(0.3, 1.9, 0.0));
     let triangle = Quadrilateral::triangle(a, b, c).unwrap();
-    let mut state = 7u64;
-    let mut next = || {
-        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-        ((state >> 11) as f64 / (1u64 << 53) as f64) * 3.0 - 0.5
-    };
+    let mut rng = Lcg(7);
+    // Coordinates in [-0.5, 2.5): around both outlines.
+    let mut next = || 1.0 + 1.5 * rng.next();
     let (mut hits, mut tri_hits) = (0, 0);
     for _ in 0..4000 {
         let p = vec3(next(), next(), 0.01 + 0.3 * next().abs());
