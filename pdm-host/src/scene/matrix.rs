@@ -192,9 +192,9 @@ struct Context<'s, T> {
     piece_polygons: Vec<Vec<Option<[Vec3<f64>; 4]>>>,
     /// Per patch: its corners, if it has straight edges.
     polygons: Vec<Option<[Vec3<f64>; 4]>>,
-    /// Per surface: whether it stands for its entry's (or mesh group's) occluder, the first of
-    /// the two sides that occludes.
-    stands: Vec<bool>,
+    /// The occluders by bounding box: one per piece of each surface that stands for its
+    /// entry's (or mesh group's) occluder, the first of the two sides that occludes.
+    tree: super::bvh::Occluders,
     tol: f64,
 }
 
@@ -230,6 +230,35 @@ impl<T: Real> Context<'_, T> {
         }
     }
 
+    /// Whether surface `k`'s occluders may cut the segments between patches `i` and `j` by
+    /// what the surfaces are (a surface does not block chords of its own convex side).
+    fn surface_may_cut(&self, k: usize, i: usize, j: usize) -> bool {
+        let scene = self.scene;
+        let (pi, pj) = (&scene.patches[i], &scene.patches[j]);
+        let (si, sj, s) = (&scene.surfaces[pi.surface], &scene.surfaces[pj.surface], &scene.surfaces[k]);
+        // A mesh's facets are occluders one by one: a pair's own facets are left out by the
+        // plane test, like any flat occluder with both patches on one side.
+        if (s.entry == si.entry || s.entry == sj.entry) && s.kind != Kind::Mesh {
+            // A segment between two points of one surface is a chord of its solid (a Bézier
+            // sheet is taken to be part of a convex surface, SCENES.md); a flat sheet or a
+            // convex side never blocks a segment that starts on it and passes the facing
+            // test; a concave side (or a Bézier piece that bends both ways) blocks only
+            // segments that leave its solid.
+            if si.entry == sj.entry {
+                return false;
+            }
+            let (on, other) = if s.entry == si.entry { (pi, j) } else { (pj, i) };
+            if !self.piece_concave[on.surface][on.piece] {
+                return false;
+            }
+            let po = &scene.patches[other];
+            if inside_solid(scene.geom(on), scene.geom(po), po, self.balls[other], self.tol) {
+                return false;
+            }
+        }
+        true
+    }
+
     fn plan(&self, i: usize, j: usize) -> Plan<T> {
         let scene = self.scene;
         let (pi, pj) = (&scene.patches[i], &scene.patches[j]);
@@ -262,52 +291,45 @@ impl<T: Real> Context<'_, T> {
         let mut list = Vec::new();
         // The two patches' hull, built when a flat occluder first needs it.
         let mut hull = None;
-        for (k, s) in scene.surfaces.iter().enumerate() {
-            if !self.stands[k] {
+        // Only the occluders whose boxes come near the pair's capsule (`bvh`), in scene order.
+        let reach = bi.radius.to_f64().max(bj.radius.to_f64()) + self.tol;
+        let near = self.tree.near_segment(self.balls[i].0, self.balls[j].0, reach);
+        let mut surface_ok: Option<(usize, bool)> = None;
+        for (k, piece) in near {
+            let ok = match surface_ok {
+                Some((at, ok)) if at == k => ok,
+                _ => {
+                    let ok = self.surface_may_cut(k, i, j);
+                    surface_ok = Some((k, ok));
+                    ok
+                }
+            };
+            if !ok {
                 continue;
             }
-            // A mesh's facets are occluders one by one: a pair's own facets are left out by the
-            // plane test below, like any flat occluder with both patches on one side.
-            if (s.entry == si.entry || s.entry == sj.entry) && s.kind != Kind::Mesh {
-                // A segment between two points of one surface is a chord of its solid (a Bézier
-                // sheet is taken to be part of a convex surface, SCENES.md); a flat sheet or a
-                // convex side never blocks a segment that starts on it and passes the facing
-                // test; a concave side (or a Bézier piece that bends both ways) blocks only
-                // segments that leave its solid.
-                if si.entry == sj.entry {
-                    continue;
-                }
-                let (on, other) = if s.entry == si.entry { (pi, j) } else { (pj, i) };
-                if !concave(on) {
-                    continue;
-                }
-                let po = &scene.patches[other];
-                if inside_solid(scene.geom(on), scene.geom(po), po, self.balls[other], self.tol) {
+            let (Some(occluder), Some(plane), Some(polygon)) =
+                (self.occluders[k].get(piece), self.piece_planes[k].get(piece), self.piece_polygons[k].get(piece))
+            else {
+                continue;
+            };
+            if !occluder.may_block_between(bi, bj) {
+                continue;
+            }
+            if let Some(plane) = plane {
+                let (lo_i, hi_i) = gi.distance_range(pi.rect, plane);
+                let (lo_j, hi_j) = gj.distance_range(pj.rect, plane);
+                if (lo_i >= -self.tol && lo_j >= -self.tol) || (hi_i <= self.tol && hi_j <= self.tol) {
                     continue;
                 }
             }
-            for ((occluder, plane), polygon) in
-                self.occluders[k].iter().zip(&self.piece_planes[k]).zip(&self.piece_polygons[k])
-            {
-                if !occluder.may_block_between(bi, bj) {
+            // Flat polygons touching the pair's hull (a mesh's neighbours): a separating plane.
+            if let (Some(o), Some(a), Some(b)) = (polygon, &self.polygons[i], &self.polygons[j]) {
+                let hull = hull.get_or_insert_with(|| super::separate::Hull::new(&[*a, *b].concat()));
+                if hull.weakly_separated_from(o, self.tol) {
                     continue;
                 }
-                if let Some(plane) = plane {
-                    let (lo_i, hi_i) = gi.distance_range(pi.rect, plane);
-                    let (lo_j, hi_j) = gj.distance_range(pj.rect, plane);
-                    if (lo_i >= -self.tol && lo_j >= -self.tol) || (hi_i <= self.tol && hi_j <= self.tol) {
-                        continue;
-                    }
-                }
-                // Flat polygons touching the pair's hull (a mesh's neighbours): a separating plane.
-                if let (Some(o), Some(a), Some(b)) = (polygon, &self.polygons[i], &self.polygons[j]) {
-                    let hull = hull.get_or_insert_with(|| super::separate::Hull::new(&[*a, *b].concat()));
-                    if hull.weakly_separated_from(o, self.tol) {
-                        continue;
-                    }
-                }
-                list.push(*occluder);
             }
+            list.push(*occluder);
         }
         Plan::Integrate(list)
     }
@@ -395,7 +417,7 @@ fn compute_with<T: Real, const CAP: usize>(
         occluders.push(if s.occludes { list.iter().filter_map(occluder_of).collect() } else { Vec::new() });
         shapes.push(list);
     }
-    let stands = (0..scene.surfaces.len())
+    let stands: Vec<bool> = (0..scene.surfaces.len())
         .map(|k| {
             let s = &scene.surfaces[k];
             !occluders[k].is_empty()
@@ -405,6 +427,15 @@ fn compute_with<T: Real, const CAP: usize>(
                     .any(|(o, list)| o.entry == s.entry && o.group == s.group && !list.is_empty())
         })
         .collect();
+    let mut entries = Vec::new();
+    for (k, s) in scene.surfaces.iter().enumerate() {
+        if stands[k] {
+            for (p, piece) in s.pieces.iter().enumerate() {
+                entries.push(super::bvh::Entry::new(k, p, &piece.geom, piece.geom.domain()));
+            }
+        }
+    }
+    let tree = super::bvh::Occluders::new(entries);
     let piece_concave = scene.surfaces.iter().map(|s| s.pieces.iter().map(|p| p.geom.concave()).collect()).collect();
     let piece_planes = scene.surfaces.iter().map(|s| s.pieces.iter().map(|p| p.geom.plane()).collect()).collect();
     let piece_polygons = scene
@@ -424,7 +455,7 @@ fn compute_with<T: Real, const CAP: usize>(
         piece_planes,
         piece_polygons,
         polygons,
-        stands,
+        tree,
         tol: 0.0,
     };
     let mut info = Vec::with_capacity(scene.patches.len());

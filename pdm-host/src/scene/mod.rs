@@ -8,6 +8,7 @@
 #![allow(clippy::indexing_slicing)]
 
 pub mod build;
+pub mod bvh;
 pub mod matrix;
 pub mod mesh;
 pub mod model;
