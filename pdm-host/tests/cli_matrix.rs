@@ -116,3 +116,45 @@ fn slices_merge_into_the_whole() {
     let out = pdm(&["matrix", &scene, "--shard", "4/3", "--output", "x.json"]);
     assert_eq!(out.status.code(), Some(2));
 }
+
+fn pdm_in(dir: &std::path::Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_pdm-ff")).current_dir(dir).args(args).output().expect("run pdm-ff")
+}
+
+/// A View3D input file runs as it is: rows named as in it, View3D's own settings reported as
+/// notes; its slices, computed in one folder and merged from another, find the file again.
+#[test]
+fn view3d_file_runs_unchanged_and_its_slices_merge_from_anywhere() {
+    let models = tempfile::tempdir().unwrap();
+    let vs3 = "T two squares\nC encl=0 maxU=8\nF 3\nV 1 0 0 0\nV 2 1 0 0\nV 3 1 1 0\nV 4 0 1 0\nV 5 0 0 1\nV 6 1 0 1\n\
+               V 7 1 1 1\nV 8 0 1 1\nS 1 1 2 3 4 0 0 0.9 low\nS 2 5 8 7 6 0 0 0.9 high ! facing down\nE\n";
+    std::fs::write(models.path().join("two.vs3"), vs3).unwrap();
+    let out = pdm_in(models.path(), &["matrix", "two.vs3", "--tolerance", "1e-10"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let low = stdout.lines().find(|l| l.starts_with("low ")).unwrap_or_else(|| panic!("{stdout}"));
+    assert!(low.contains("0.1998248957"), "C-11: {low}");
+    assert!(String::from_utf8_lossy(&out.stderr).contains("note: two.vs3: maxU = 8"));
+
+    let work = tempfile::tempdir().unwrap();
+    let file = models.path().join("two.vs3");
+    let mut parts = Vec::new();
+    for k in 1..=2 {
+        let part = work.path().join(format!("p{k}.json"));
+        let shard = format!("{k}/2");
+        let out = pdm(&["matrix", file.to_str().unwrap(), "--shard", &shard, "--output", part.to_str().unwrap()]);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        parts.push(part.to_str().unwrap().to_string());
+    }
+    let elsewhere = tempfile::tempdir().unwrap();
+    let out = pdm_in(elsewhere.path(), &["merge", &parts[0], &parts[1]]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("0.1998248957"));
+
+    std::fs::write(models.path().join("bad.vs3"), "F 3\nV 1 0 0 0\nS 1 1 2 3 0 0 0 0.9 a\n").unwrap();
+    let out = pdm_in(models.path(), &["matrix", "bad.vs3"]);
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(stderr.starts_with("error: bad.vs3:3: surface 1 refers to vertex 2"), "{stderr}");
+}

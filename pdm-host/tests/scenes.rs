@@ -274,6 +274,38 @@ mod parser {
             ).replace("NaN", "nan");
             let _ = from_text(&text, Format::Toml, "p.toml");
         }
+
+        /// View3D files: arbitrary text, and well-formed lines with arbitrary numbers and
+        /// vertex, base and combination references, give surfaces or an error, never a panic.
+        #[test]
+        fn arbitrary_view3d_files_never_panic(
+            text in "\\PC{0,200}",
+            xs in prop::collection::vec(prop::num::f64::ANY, 12),
+            refs in prop::collection::vec(0usize..7, 12),
+            kinds in prop::collection::vec(prop::sample::select(vec!["S", "O", "N", "M"]), 3),
+            blast in any::<bool>(),
+        ) {
+            use pdm_host::scene::vs3;
+            if let Ok(v) = vs3::parse(&text) {
+                let _ = vs3::groups(&v);
+            }
+            let mut t = String::from(if blast { "F 3a\n" } else { "F 3\n" });
+            for (k, x) in xs.chunks(3).enumerate() {
+                t += &format!("V {} {:?} {:?} {:?}\n", k + 1, x[0], x[1], x[2]);
+            }
+            for (k, kind) in kinds.iter().enumerate() {
+                let r = &refs[4 * k..4 * k + 4];
+                if blast {
+                    t += &format!("{kind} {} Q {} {} 0.9 s{k}\n 0 0 0 {:?} {:?}\n", k + 1, r[0], r[1], xs[k], xs[k + 1]);
+                    t += &format!("{:?} 0 1 0 1 1 0 {:?}\n", xs[k + 2], xs[k + 3]);
+                } else {
+                    t += &format!("{kind} {} {} {} {} {} {} {} 0.9 s{k}\n", k + 1, r[0], r[1], r[2], r[3], r[0] % 3, r[1] % 3);
+                }
+            }
+            if let Ok(v) = vs3::parse(&t.replace("NaN", "nan")) {
+                let _ = vs3::groups(&v);
+            }
+        }
     }
 }
 
@@ -570,4 +602,126 @@ fn room_example_loads_with_quadrilateral_facets() {
     // 4 floor pieces around the cabinet, 5 room faces, 6 table faces, 5 cabinet faces, the lamp.
     assert_eq!(s.patches.len(), 4 + 5 + 6 + 5 + 1);
     assert!(s.enclosure);
+}
+
+/// A unit cube as a View3D file (format F 3, vertices counter-clockwise seen from inside),
+/// with a triangular window (a subsurface, `base` = 1) and a square null surface cut out of
+/// the floor. The floor keeps what is left, so the floor and the window together are the
+/// floor of the plain cube: their factors from the ceiling and a wall add up to C-11 and C-14,
+/// and each row of the enclosure sums to 1.
+const VS3_CUBE: &str = "T unit cube with a window in the floor
+C encl=1 eps=1e-4
+F 3
+V 1 0 0 0
+V 2 1 0 0
+V 3 1 1 0
+V 4 0 1 0
+V 5 0 0 1
+V 6 1 0 1
+V 7 1 1 1
+V 8 0 1 1
+V 9 0.2 0.2 0
+V 10 0.6 0.3 0
+V 11 0.3 0.7 0
+V 12 0.7 0.6 0
+V 13 0.9 0.6 0
+V 14 0.9 0.9 0
+V 15 0.7 0.9 0
+S 1 1 2 3 4 0 0 0.9 floor   ! faces up, into the cube
+S 2 7 6 5 8 0 0 0.9 ceiling
+S 3 1 5 6 2 0 0 0.9 south
+S 4 7 8 4 3 0 0 0.9 north
+S 5 1 4 8 5 0 0 0.9 west
+S 6 7 3 2 6 0 0 0.9 east
+S 7 9 10 11 0 1 0 0.9 window
+N 8 12 15 14 13 1 0 0.9 vent
+E
+";
+
+#[test]
+fn view3d_file_with_a_window_against_c11_c14_and_the_sum_rule() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("cube.vs3");
+    std::fs::write(&path, VS3_CUBE).unwrap();
+    let s = pdm_host::scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    assert!(s.enclosure, "encl=1");
+    let names: Vec<_> = s.surfaces.iter().map(|x| x.name.as_str()).collect();
+    assert_eq!(names, ["floor", "ceiling", "south", "north", "west", "east", "window"]);
+    let r = run(&s, PairMethod::Tolerance(1e-10));
+    let (window, vent) = (0.5 * 0.4f64.mul_add(0.5, -0.1 * 0.1), 0.2 * 0.3);
+    assert!((r.surfaces.areas[index(&r, "window")] - window).abs() < 1e-14);
+    assert!((r.surfaces.areas[index(&r, "floor")] - (1.0 - window - vent)).abs() < 1e-14);
+    let opposite = closed_form::parallel_rectangles(1.0, 1.0, 1.0); // C-11
+    let adjacent = closed_form::perpendicular_rectangles(1.0, 1.0, 1.0); // C-14
+    for (from, whole) in [("ceiling", opposite), ("south", adjacent), ("east", adjacent)] {
+        let sum = factor(&r, from, "floor") + factor(&r, from, "window");
+        // The vent is a hole: what the floor loses to it nobody gains.
+        assert!(sum < whole - 1e-3, "{from}: {sum} against {whole}");
+    }
+    // Without the vent the floor and the window make the whole floor again.
+    let no_vent = VS3_CUBE.replace("N 8 12 15 14 13 1 0 0.9 vent\n", "");
+    std::fs::write(&path, no_vent).unwrap();
+    let s = pdm_host::scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    let r = run(&s, PairMethod::Tolerance(1e-10));
+    for (from, whole) in [("ceiling", opposite), ("south", adjacent), ("north", adjacent), ("west", adjacent)] {
+        let sum = factor(&r, from, "floor") + factor(&r, from, "window");
+        assert!((sum - whole).abs() < 1e-9 * whole, "{from}: {sum} against {whole}");
+    }
+    for (i, sum) in r.surfaces.row_sums.iter().enumerate() {
+        assert!((sum - 1.0).abs() < 1e-9, "row {}: {sum}", r.surfaces.names[i]);
+    }
+    assert_eq!(factor(&r, "floor", "window"), 0.0, "one plane");
+    assert!(r.diagnostics.enclosure_gaps.is_empty());
+}
+
+/// View3D obstruction surfaces (`O`) block the view and get no row; one that covers the view
+/// between two squares leaves nothing, one beside it changes nothing (C-11).
+#[test]
+fn view3d_obstructions_block_without_a_row() {
+    let text = |o: &str| {
+        format!(
+            "F 3\nV 1 0 0 0\nV 2 1 0 0\nV 3 1 1 0\nV 4 0 1 0\nV 5 0 0 1\nV 6 1 0 1\nV 7 1 1 1\nV 8 0 1 1\n{o}\
+             S 1 1 2 3 4 0 0 0.9 low\nS 2 5 8 7 6 0 0 0.9 high\nO 3 9 10 11 12\nE\n"
+        )
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("o.vs3");
+    let covering = "V 9 -1 -1 0.5\nV 10 2 -1 0.5\nV 11 2 2 0.5\nV 12 -1 2 0.5\n";
+    let beside = "V 9 3 0 0\nV 10 4 0 0\nV 11 4 0 1\nV 12 3 0 1\n";
+    for (vertices, expected) in [(covering, 0.0), (beside, closed_form::parallel_rectangles(1.0, 1.0, 1.0))] {
+        std::fs::write(&path, text(vertices)).unwrap();
+        let s = pdm_host::scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(s.surfaces.len(), 2);
+        assert_eq!(s.obstructions.len(), 1);
+        let r = run(&s, PairMethod::Tolerance(1e-10));
+        assert_eq!(r.surfaces.names, ["low", "high"]);
+        assert!((factor(&r, "low", "high") - expected).abs() < 1e-10, "{}", factor(&r, "low", "high"));
+    }
+    // The same obstruction from a TOML file: `radiates = false`.
+    let toml = "[[surface]]\nname = \"low\"\nkind = \"rectangle\"\norigin = [0, 0, 0]\nedge_t = [1, 0, 0]\nedge_s = [0, 1, 0]\n\n\
+                [[surface]]\nname = \"high\"\nkind = \"rectangle\"\norigin = [0, 0, 1]\nedge_t = [0, 1, 0]\nedge_s = [1, 0, 0]\n\n\
+                [[surface]]\nname = \"screen\"\nkind = \"rectangle\"\nradiates = false\norigin = [-1, -1, 0.5]\nedge_t = [3, 0, 0]\nedge_s = [0, 3, 0]\n";
+    let r = run(&scene(toml), PairMethod::Tolerance(1e-10));
+    assert_eq!(r.surfaces.names, ["low", "high"]);
+    assert_eq!(factor(&r, "low", "high"), 0.0);
+    let e = from_text(&toml.replace("radiates = false", "radiates = false\noccludes = false"), Format::Toml, "t.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("field `radiates`"), "{e}");
+}
+
+/// Bad View3D files: one line naming the file and the line.
+#[test]
+fn bad_view3d_files_name_file_and_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("bad.vs3");
+    for (text, place, words) in [
+        ("F 3\nV 1 0 0 0\nV 2 1 0 0\nS 1 1 2 3 0 0 0 0.9 a\n", "bad.vs3:4:", "vertex 3"),
+        ("F 3\nV 1 0 0 0\nV 2 1 0 0\nV 3 1 1 0\nV 4 0 1 1\nS 1 1 2 3 4 0 0 0.9 a\n", "bad.vs3", "not flat"),
+        ("F 3\nV 1 0 0 0\nV 2 1 0 0\nV 3 0 1 0\nM 1 1 2 3 0 0 0 0.9 m\n", "bad.vs3:5:", "masking"),
+    ] {
+        std::fs::write(&path, text).unwrap();
+        let e = pdm_host::scene::load(&path).unwrap_err().to_string();
+        assert!(e.contains(place) && e.contains(words) && !e.contains('\n'), "{e}");
+    }
 }

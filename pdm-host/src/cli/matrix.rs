@@ -118,7 +118,8 @@ pub fn run_merge(args: &MergeArgs) -> ExitCode {
         eprintln!("error: {}: another scene, method or precision than {}", path.display(), first_path.display());
         return ExitCode::from(EXIT_USAGE);
     }
-    let scene = match scene::build(&first.scene) {
+    let folder = first.folder.clone().unwrap_or_else(|| PathBuf::from("."));
+    let scene = match scene::build::build_in(&first.scene, &folder) {
         Ok(s) => s,
         Err(e) => {
             eprintln!("error: {}: the scene in it does not build: {}", first_path.display(), e.message);
@@ -149,6 +150,9 @@ pub fn run(args: &MatrixArgs) -> ExitCode {
             return ExitCode::from(EXIT_USAGE);
         }
     };
+    for note in scene::vs3_notes(&args.scene) {
+        eprintln!("note: {}: {note}", args.scene.display());
+    }
     if let Some(out) = &args.output {
         if !output_format_ok(out) {
             eprintln!("error: --output {}: unknown format (use a .csv, .json, .npy or .npz file name)", out.display());
@@ -195,7 +199,10 @@ pub fn run(args: &MatrixArgs) -> ExitCode {
         };
         let pairs = result.pairs.len();
         let (skipped, seconds) = (result.skipped, result.seconds);
-        let slice = scene::SliceFile { scene: model, method, precision: precision.into(), result };
+        // Where `merge` finds the scene's mesh files, wherever it runs from.
+        let folder = args.scene.parent().map(|p| if p.as_os_str().is_empty() { std::path::Path::new(".") } else { p });
+        let folder = folder.and_then(|p| std::fs::canonicalize(p).ok());
+        let slice = scene::SliceFile { scene: model, method, precision: precision.into(), folder, result };
         let written = serde_json::to_vec(&slice)
             .map_err(|e| e.to_string())
             .and_then(|bytes| report::write_atomic(out, &bytes).map_err(|e| e.to_string()));

@@ -65,13 +65,27 @@ pub struct Scene {
     pub units: String,
     /// Whether the surfaces close an enclosure.
     pub enclosure: bool,
-    /// The surfaces (a two-sided entry gives two).
+    /// The surfaces with rows and columns in the matrices (a two-sided entry gives two).
     pub surfaces: Vec<SceneSurface>,
+    /// Surfaces that only block the view (`radiates = false`, View3D's obstruction surfaces):
+    /// no patches, no rows.
+    pub obstructions: Vec<SceneSurface>,
     /// All patches, surface by surface, piece by piece, row by row.
     pub patches: Vec<ScenePatch>,
 }
 
 impl Scene {
+    /// Surface `k` of the surfaces followed by the obstructions.
+    #[must_use]
+    pub fn any_surface(&self, k: usize) -> &SceneSurface {
+        self.surfaces.get(k).unwrap_or_else(|| &self.obstructions[k - self.surfaces.len()])
+    }
+
+    /// The surfaces followed by the obstructions (the occluders' owners).
+    pub fn all_surfaces(&self) -> impl Iterator<Item = &SceneSurface> {
+        self.surfaces.iter().chain(&self.obstructions)
+    }
+
     /// The geometry of a patch.
     #[must_use]
     pub fn geom(&self, p: &ScenePatch) -> &Geom {
@@ -194,7 +208,7 @@ fn geometry(i: usize, spec: &SurfaceSpec, flip: bool, place: &Place, base: &Path
             return fail(i, spec, field, format!("does not belong to kind {}", spec.kind.name()));
         }
     }
-    let full = |g: Geom| Ok(vec![(String::new(), vec![(g, g.domain())])]);
+    let full = |g: Geom| Ok(vec![(String::new(), true, vec![(g, g.domain())])]);
     match spec.kind {
         Kind::Rectangle => {
             let origin = place.point(vector(i, spec, "origin", spec.origin)?);
@@ -219,7 +233,7 @@ fn geometry(i: usize, spec: &SurfaceSpec, flip: bool, place: &Place, base: &Path
             let frame = direction(i, spec, "normal", if flip { -axis } else { axis })?;
             let (a, b) = angles(i, spec, "theta", spec.theta, 360.0)?;
             let g = Geom::Disk { center, frame, inner, outer };
-            Ok(vec![(String::new(), vec![(g, ParamRect { t0: inner, t1: outer, s0: a, s1: b })])])
+            Ok(vec![(String::new(), true, vec![(g, ParamRect { t0: inner, t1: outer, s0: a, s1: b })])])
         }
         Kind::Sphere => {
             let center = place.point(vector(i, spec, "center", spec.center)?);
@@ -233,7 +247,7 @@ fn geometry(i: usize, spec: &SurfaceSpec, flip: bool, place: &Place, base: &Path
             let (p0, p1) = angles(i, spec, "phi", spec.phi, 180.0)?;
             let (a, b) = angles(i, spec, "theta", spec.theta, 360.0)?;
             let g = Geom::Sphere { center, radius, frame, inner: flip };
-            Ok(vec![(String::new(), vec![(g, ParamRect { t0: p0, t1: p1, s0: a, s1: b })])])
+            Ok(vec![(String::new(), true, vec![(g, ParamRect { t0: p0, t1: p1, s0: a, s1: b })])])
         }
         Kind::Cylinder | Kind::Cone => {
             let base = place.point(vector(i, spec, "base", spec.base)?);
@@ -259,7 +273,7 @@ fn geometry(i: usize, spec: &SurfaceSpec, flip: bool, place: &Place, base: &Path
                 }
                 Geom::Cone { base, frame, base_radius, top_radius, height, inner: flip }
             };
-            Ok(vec![(String::new(), vec![(g, ParamRect { t0: a, t1: b, s0: 0.0, s1: height })])])
+            Ok(vec![(String::new(), true, vec![(g, ParamRect { t0: a, t1: b, s0: 0.0, s1: height })])])
         }
         Kind::Triangle | Kind::Quadrilateral => {
             let count = if spec.kind == Kind::Triangle { 3 } else { 4 };
@@ -312,7 +326,7 @@ fn geometry(i: usize, spec: &SurfaceSpec, flip: bool, place: &Place, base: &Path
                     out.push((g, g.domain()));
                 }
             }
-            Ok(vec![(String::new(), out)])
+            Ok(vec![(String::new(), true, out)])
         }
         Kind::Mesh => {
             let Some(name) = &spec.file else { return fail(i, spec, "file", "missing (kind mesh needs it)") };
@@ -323,8 +337,9 @@ fn geometry(i: usize, spec: &SurfaceSpec, flip: bool, place: &Place, base: &Path
                 Err(e) => return fail(i, spec, "file", e),
             };
             let several = groups.len() > 1;
+            let prefixed = spec.prefix.unwrap_or(true);
             let mut out = Vec::new();
-            for (group, polygons) in groups {
+            for super::mesh::Group { name: group, faces: polygons, radiates } in groups {
                 let mut pieces = Vec::new();
                 for (k, polygon) in polygons.iter().enumerate() {
                     if polygon.iter().any(|p| !p.is_finite()) {
@@ -357,7 +372,12 @@ fn geometry(i: usize, spec: &SurfaceSpec, flip: bool, place: &Place, base: &Path
                         pieces.push((g, g.domain()));
                     }
                 }
-                out.push((if several { format!("/{group}") } else { String::new() }, pieces));
+                let name = match (prefixed, several) {
+                    (true, true) => format!("/{group}"),
+                    (true, false) => String::new(),
+                    (false, _) => group,
+                };
+                out.push((name, radiates, pieces));
             }
             Ok(out)
         }
@@ -370,8 +390,10 @@ fn reversed([p0, p1, p2, p3]: [Vec3<f64>; 4]) -> [Vec3<f64>; 4] {
     [p0, p3, p2, p1]
 }
 
-/// Pieces of one entry's side by group (a mesh file's objects; one unnamed group otherwise).
-type Groups = Vec<(String, Vec<(Geom, Rect)>)>;
+/// Pieces of one entry's side by group (a mesh file's objects; one unnamed group otherwise):
+/// the name's suffix (or the whole name, for a mesh with `prefix = false`), whether the group
+/// radiates (a View3D obstruction does not), the pieces.
+type Groups = Vec<(String, bool, Vec<(Geom, Rect)>)>;
 
 /// Arc length of the parameter line through the middle of `rect` along t (`along_t`) or s.
 fn mid_length(geom: &Geom, rect: Rect, along_t: bool) -> f64 {
@@ -406,6 +428,7 @@ pub fn build_in(file: &SceneFile, base: &Path) -> Result<Scene, EntryError> {
         });
     }
     let mut surfaces = Vec::new();
+    let mut obstructions = Vec::new();
     for (i, spec) in file.surfaces.iter().enumerate() {
         if spec.name.trim().is_empty() {
             return fail(i, spec, "name", "is empty");
@@ -451,13 +474,18 @@ pub fn build_in(file: &SceneFile, base: &Path) -> Result<Scene, EntryError> {
                 return fail(i, spec, "subdivide", format!("[{m}, {n}] must lie in 1..={MAX_SUBDIVISION}"));
             }
         }
+        if spec.prefix.is_some() && spec.kind != Kind::Mesh {
+            return fail(i, spec, "prefix", format!("applies to kind mesh only, not {}", spec.kind.name()));
+        }
         if let Some(size) = spec.patch_size {
             if !(size.is_finite() && size > 0.0) {
                 return fail(i, spec, "patch_size", format!("{size} must be positive and finite"));
             }
         }
         for (flip, suffix) in sides {
-            for (group, (group_name, list)) in geometry(i, spec, flip, &place, base)?.into_iter().enumerate() {
+            for (group, (group_name, group_radiates, list)) in
+                geometry(i, spec, flip, &place, base)?.into_iter().enumerate()
+            {
                 let mut pieces = Vec::new();
                 for (geom, rect) in list {
                     let grid =
@@ -500,14 +528,30 @@ pub fn build_in(file: &SceneFile, base: &Path) -> Result<Scene, EntryError> {
                         ),
                     );
                 }
-                surfaces.push(SceneSurface {
-                    name: format!("{}{group_name}{suffix}", spec.name),
-                    kind: spec.kind,
-                    entry: i,
-                    group,
-                    occludes,
-                    pieces,
-                });
+                let radiates = group_radiates && spec.radiates.unwrap_or(true);
+                if !radiates && !occludes {
+                    return fail(
+                        i,
+                        spec,
+                        "radiates",
+                        "is false and so is occludes: the surface would do nothing (an obstruction must occlude)",
+                    );
+                }
+                let name = if spec.kind == Kind::Mesh && !spec.prefix.unwrap_or(true) {
+                    format!("{group_name}{suffix}")
+                } else {
+                    format!("{}{group_name}{suffix}", spec.name)
+                };
+                if let Some(other) = surfaces.iter().chain(&obstructions).find(|s: &&SceneSurface| s.name == name) {
+                    return fail(
+                        i,
+                        spec,
+                        "name",
+                        format!("gives the surface name `{name}`, which surface #{} already has", other.entry + 1),
+                    );
+                }
+                let list = if radiates { &mut surfaces } else { &mut obstructions };
+                list.push(SceneSurface { name, kind: spec.kind, entry: i, group, occludes, pieces });
             }
         }
     }
@@ -536,5 +580,13 @@ pub fn build_in(file: &SceneFile, base: &Path) -> Result<Scene, EntryError> {
             }
         }
     }
-    Ok(Scene { units: file.units.clone(), enclosure: file.enclosure, surfaces, patches })
+    if surfaces.is_empty() {
+        return Err(EntryError {
+            entry: 0,
+            name: String::new(),
+            field: "surface".into(),
+            message: "the scene has no radiating surfaces (only obstructions)".into(),
+        });
+    }
+    Ok(Scene { units: file.units.clone(), enclosure: file.enclosure, surfaces, obstructions, patches })
 }

@@ -235,7 +235,7 @@ impl<T: Real> Context<'_, T> {
     fn surface_may_cut(&self, k: usize, i: usize, j: usize) -> bool {
         let scene = self.scene;
         let (pi, pj) = (&scene.patches[i], &scene.patches[j]);
-        let (si, sj, s) = (&scene.surfaces[pi.surface], &scene.surfaces[pj.surface], &scene.surfaces[k]);
+        let (si, sj, s) = (&scene.surfaces[pi.surface], &scene.surfaces[pj.surface], scene.any_surface(k));
         // A mesh's facets are occluders one by one: a pair's own facets are left out by the
         // plane test, like any flat occluder with both patches on one side.
         if (s.entry == si.entry || s.entry == sj.entry) && s.kind != Kind::Mesh {
@@ -407,9 +407,11 @@ fn compute_with<T: Real, const CAP: usize>(
 ) -> Result<MatrixResult, MatrixError> {
     let start = Instant::now();
     let at = |i: usize| move |error| PairError { i, j: i, error };
-    let mut shapes = Vec::with_capacity(scene.surfaces.len());
-    let mut occluders = Vec::with_capacity(scene.surfaces.len());
-    for (k, s) in scene.surfaces.iter().enumerate() {
+    // Indexed by surface, the obstructions after the radiating surfaces.
+    let all: Vec<_> = scene.all_surfaces().collect();
+    let mut shapes = Vec::with_capacity(all.len());
+    let mut occluders = Vec::with_capacity(all.len());
+    for (k, s) in all.iter().enumerate() {
         let first = scene.patches.iter().position(|p| p.surface == k).unwrap_or(0);
         let list = s.pieces.iter().map(|p| p.geom.shape::<T>()).collect::<Result<Vec<_>, _>>().map_err(at(first))?;
         // Every piece of an occluding surface is one (the scene's builder refuses `occludes` on
@@ -417,18 +419,18 @@ fn compute_with<T: Real, const CAP: usize>(
         occluders.push(if s.occludes { list.iter().filter_map(occluder_of).collect() } else { Vec::new() });
         shapes.push(list);
     }
-    let stands: Vec<bool> = (0..scene.surfaces.len())
+    let stands: Vec<bool> = (0..all.len())
         .map(|k| {
-            let s = &scene.surfaces[k];
+            let s = all[k];
             !occluders[k].is_empty()
-                && !scene.surfaces[..k]
+                && !all[..k]
                     .iter()
                     .zip(&occluders)
                     .any(|(o, list)| o.entry == s.entry && o.group == s.group && !list.is_empty())
         })
         .collect();
     let mut entries = Vec::new();
-    for (k, s) in scene.surfaces.iter().enumerate() {
+    for (k, s) in all.iter().enumerate() {
         if stands[k] {
             for (p, piece) in s.pieces.iter().enumerate() {
                 entries.push(super::bvh::Entry::new(k, p, &piece.geom, piece.geom.domain()));
@@ -436,10 +438,9 @@ fn compute_with<T: Real, const CAP: usize>(
         }
     }
     let tree = super::bvh::Occluders::new(entries);
-    let piece_concave = scene.surfaces.iter().map(|s| s.pieces.iter().map(|p| p.geom.concave()).collect()).collect();
-    let piece_planes = scene.surfaces.iter().map(|s| s.pieces.iter().map(|p| p.geom.plane()).collect()).collect();
-    let piece_polygons = scene
-        .surfaces
+    let piece_concave = all.iter().map(|s| s.pieces.iter().map(|p| p.geom.concave()).collect()).collect();
+    let piece_planes = all.iter().map(|s| s.pieces.iter().map(|p| p.geom.plane()).collect()).collect();
+    let piece_polygons = all
         .iter()
         .map(|s| s.pieces.iter().map(|p| super::separate::polygon(&p.geom, p.geom.domain())).collect())
         .collect();

@@ -1,5 +1,6 @@
-//! Flat facets from mesh files: OBJ (`tobj`, in f64, one group per OBJ object or group) and STL
-//! (`stl_io`, ASCII or binary, one group). A flat convex quadrilateral face stays one facet,
+//! Flat facets from mesh files: OBJ (`tobj`, in f64, one group per OBJ object or group), STL
+//! (`stl_io`, ASCII or binary, one group) and View3D input files (`.vs3`, [`super::vs3`], one
+//! group per output surface). A flat convex quadrilateral face stays one facet,
 //! the kernel's `Quadrilateral`; any other face is cut into triangles, each triangle A B C
 //! the `Quadrilateral` A B C A, g(t, s) = A + t·(B − A + s·(C − B)), whose normal
 //! t·(B − A) × (C − A) points to the side the vertices turn counter-clockwise around: a flat
@@ -58,8 +59,19 @@ pub fn facets(polygon: &[Vec3<f64>]) -> Vec<Facet> {
     }
 }
 
-/// A mesh file's faces by group: (group name, each face's vertices in order).
-pub type Groups = Vec<(String, Vec<Vec<Vec3<f64>>>)>;
+/// A group of a mesh file's faces: one surface of the scene.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Group {
+    /// The OBJ object or group, the View3D surface; empty for an STL file.
+    pub name: String,
+    /// Each face's vertices in order.
+    pub faces: Vec<Vec<Vec3<f64>>>,
+    /// `false` for a View3D obstruction surface (`O`): it blocks the view and has no row.
+    pub radiates: bool,
+}
+
+/// A mesh file's faces by group.
+pub type Groups = Vec<Group>;
 
 /// The faces of a mesh file by group, as given (see [`facets`] for what they become).
 pub fn load(path: &Path) -> Result<Groups, String> {
@@ -72,7 +84,7 @@ pub fn load(path: &Path) -> Result<Groups, String> {
             for model in models {
                 let polygons = obj_polygons(path, &model)?;
                 if !polygons.is_empty() {
-                    groups.push((model.name.clone(), polygons));
+                    groups.push(Group { name: model.name.clone(), faces: polygons, radiates: true });
                 }
             }
             Ok(groups)
@@ -91,9 +103,16 @@ pub fn load(path: &Path) -> Result<Groups, String> {
                 .iter()
                 .map(|f| Ok(vec![v(f.vertices[0])?, v(f.vertices[1])?, v(f.vertices[2])?]))
                 .collect::<Result<Vec<_>, String>>()?;
-            Ok(vec![(String::new(), triangles)])
+            Ok(vec![Group { name: String::new(), faces: triangles, radiates: true }])
         }
-        _ => Err(format!("{}: unknown mesh format (use .obj or .stl)", path.display())),
+        Some("vs3") => {
+            let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+            let at = |(line, message): (usize, String)| format!("{}:{line}: {message}", path.display());
+            let file = super::vs3::parse(&text).map_err(at)?;
+            let groups = super::vs3::groups(&file).map_err(at)?;
+            Ok(groups.into_iter().map(|g| Group { name: g.name, faces: g.faces, radiates: g.radiates }).collect())
+        }
+        _ => Err(format!("{}: unknown mesh format (use .obj, .stl or View3D's .vs3)", path.display())),
     }
 }
 

@@ -15,6 +15,7 @@ pub mod model;
 pub mod report;
 pub mod separate;
 pub mod shape;
+pub mod vs3;
 
 use std::fmt;
 use std::path::Path;
@@ -44,6 +45,19 @@ impl fmt::Display for SceneError {
 
 impl std::error::Error for SceneError {}
 
+impl SceneError {
+    /// A message that starts with its own `file:line: ` (a mesh file's) keeps only that.
+    fn with_own_location(self) -> Self {
+        match self.message.split_once(": ") {
+            Some((place, rest)) if place.starts_with(&self.file) => {
+                let line = place.rsplit(':').next().and_then(|l| l.parse().ok());
+                Self { file: self.file, line, message: rest.to_string() }
+            }
+            _ => self,
+        }
+    }
+}
+
 /// The formats a scene file can be in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Format {
@@ -51,6 +65,8 @@ pub enum Format {
     Toml,
     /// JSON (`.json`).
     Json,
+    /// A View3D input file (`.vs3`): the scene is its surfaces, named as in the file.
+    Vs3,
 }
 
 impl Format {
@@ -59,6 +75,7 @@ impl Format {
     pub fn of(path: &Path) -> Self {
         match path.extension().and_then(|e| e.to_str()) {
             Some(e) if e.eq_ignore_ascii_case("json") => Self::Json,
+            Some(e) if e.eq_ignore_ascii_case("vs3") => Self::Vs3,
             _ => Self::Toml,
         }
     }
@@ -78,9 +95,38 @@ fn surface_line(text: &str, k: usize) -> Option<usize> {
     text.lines().enumerate().filter(|(_, l)| l.trim_start().starts_with("[[surface]]")).nth(k).map(|(n, _)| n + 1)
 }
 
+/// The scene of a View3D file `file` with text `text`: one `mesh` entry reading the file itself,
+/// its surfaces named as in it (`prefix = false`), an enclosure if the file says `encl = 1`,
+/// lengths in the file's (unnamed) unit.
+fn vs3_scene(text: &str, file: &str) -> Result<SceneFile, SceneError> {
+    let parsed =
+        vs3::parse(text).map_err(|(line, message)| SceneError { file: file.to_string(), line: Some(line), message })?;
+    let path = Path::new(file);
+    let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("view3d");
+    let mesh = path.file_name().and_then(|s| s.to_str()).unwrap_or(file);
+    let spec = serde_json::json!({ "name": name, "kind": "mesh", "file": mesh, "prefix": false });
+    let surface = serde_json::from_value(spec).map_err(|e| SceneError {
+        file: file.to_string(),
+        line: None,
+        message: e.to_string(),
+    })?;
+    Ok(SceneFile { units: "unit".into(), enclosure: parsed.enclosure, surfaces: vec![surface] })
+}
+
+/// The notes on a View3D file's control settings that pdm does not use (empty for other
+/// formats or an unreadable file).
+#[must_use]
+pub fn vs3_notes(path: &Path) -> Vec<String> {
+    if Format::of(path) != Format::Vs3 {
+        return Vec::new();
+    }
+    std::fs::read_to_string(path).ok().and_then(|t| vs3::parse(&t).ok()).map_or_else(Vec::new, |v| v.notes)
+}
+
 /// Parses a scene text in `format`; `file` names it in errors.
 pub fn parse(text: &str, format: Format, file: &str) -> Result<SceneFile, SceneError> {
     match format {
+        Format::Vs3 => vs3_scene(text, file),
         Format::Toml => toml::from_str::<SceneFile>(text).map_err(|e| SceneError {
             file: file.to_string(),
             line: e.span().map(|s| line_of(text, s.start)),
@@ -101,6 +147,10 @@ pub fn from_text(text: &str, format: Format, file: &str) -> Result<Scene, SceneE
     let base = Path::new(file).parent().unwrap_or(Path::new("."));
     build::build_in(&model, base).map_err(|e| {
         let line = if format == Format::Toml { surface_line(text, e.entry) } else { None };
+        // A View3D file's errors name their own file and line already.
+        if format == Format::Vs3 && e.field == "file" {
+            return SceneError { file: file.to_string(), line: None, message: e.message }.with_own_location();
+        }
         let who = if e.name.is_empty() {
             format!("surface #{}", e.entry + 1)
         } else {
@@ -146,6 +196,9 @@ pub struct SliceFile {
     pub method: matrix::PairMethod,
     /// `f32` or `f64`.
     pub precision: String,
+    /// The scene file's folder, where its mesh files are found.
+    #[serde(default)]
+    pub folder: Option<std::path::PathBuf>,
     /// The slice's pairs.
     pub result: matrix::MatrixResult,
 }

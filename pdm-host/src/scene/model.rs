@@ -134,6 +134,14 @@ pub struct SurfaceSpec {
     /// Whether the surface blocks the view between other surfaces. Default `true`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub occludes: Option<bool>,
+    /// Whether the surface has rows and columns in the matrices. `false`: it only blocks the
+    /// view (an obstruction, View3D's `O` surface; it must occlude). Default `true`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radiates: Option<bool>,
+    /// Mesh: name each surface made from the file's groups `NAME/GROUP` (`true`, the default)
+    /// or `GROUP` alone (`false`, as `pdm-ff matrix FILE.vs3` does).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub prefix: Option<bool>,
     /// Rotation about the origin, applied to the geometry before `translate`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rotate: Option<Rotation>,
