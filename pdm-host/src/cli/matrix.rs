@@ -141,6 +141,15 @@ pub fn run_merge(args: &MergeArgs) -> ExitCode {
     }
 }
 
+/// The memory the system can still give (Linux: `MemAvailable` of `/proc/meminfo`), in bytes;
+/// `None` where it cannot be read.
+fn available_memory() -> Option<u64> {
+    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
 /// Runs the command.
 pub fn run(args: &MatrixArgs) -> ExitCode {
     let (model, scene) = match scene::load_model(&args.scene) {
@@ -168,6 +177,20 @@ pub fn run(args: &MatrixArgs) -> ExitCode {
         None => PairMethod::Tolerance(args.tolerance.unwrap_or(1e-6)),
     };
     let n = scene.patches.len() as u64;
+    let needed = scene::matrix::memory_needed(scene.patches.len(), args.shard.map_or(1, |s| s.count));
+    if let Some(available) = available_memory() {
+        if needed > available {
+            eprintln!(
+                "error: {}: {} patches need about {:.1} GB for the pair results and matrices, {:.1} GB is available \
+                 (use fewer patches, or a machine with more memory)",
+                args.scene.display(),
+                n,
+                needed as f64 / 1e9,
+                available as f64 / 1e9
+            );
+            return ExitCode::from(EXIT_FAILURE);
+        }
+    }
     let bar = super::progress::Bar::with_units(n * (n + 1) / 2, "pairs");
     let progress = |k: u64| bar.set_position(k);
     let result = match args.precision {

@@ -8,8 +8,10 @@ use pdm_kernel::{vec3, Frame, ParamRect, Vec3};
 use super::model::{fields_of, Kind, SceneFile, SideSpec, SurfaceSpec};
 use super::shape::{Geom, Rect};
 
-/// Most patches a scene may have (the matrix has patches² entries).
-pub const MAX_PATCHES: usize = 5_000;
+/// Most patches a scene may have: the matrices have patches² entries (12 000 patches: 1.2 GB
+/// each in f64), and `pdm-ff matrix` also checks the memory a run needs against what the
+/// machine has before it starts.
+pub const MAX_PATCHES: usize = 12_000;
 /// Most patches along one side of one piece.
 pub const MAX_SUBDIVISION: usize = 1_000;
 
@@ -325,6 +327,10 @@ fn geometry(i: usize, spec: &SurfaceSpec, flip: bool, place: &Place, base: &Path
                     let g = Geom::Bezier { control };
                     out.push((g, g.domain()));
                 }
+            }
+            let nets: Vec<Geom> = out.iter().map(|(g, _)| *g).collect();
+            if let Some(problem) = super::fold::bezier_problem(&nets) {
+                return fail(i, spec, "control", format!("the net {problem}"));
             }
             Ok(vec![(String::new(), true, out)])
         }

@@ -370,6 +370,17 @@ impl<T: Real> Context<'_, T> {
     }
 }
 
+/// Bytes a run over `patches` patches needs at its peak, roughly: the integrated pairs of one of
+/// `slices` slices, and (for a whole run) the report's dense patch matrices, two N × N matrices
+/// of exchanges and errors and the two of factors and errors made from them.
+#[must_use]
+pub fn memory_needed(patches: usize, slices: usize) -> u64 {
+    let n = patches as u64;
+    let pairs = n * (n + 1) / 2 / slices.max(1) as u64;
+    let matrices = if slices > 1 { 0 } else { 4 * n * n * 8 };
+    pairs * std::mem::size_of::<PairValue>() as u64 + matrices
+}
+
 /// Computes every unordered pair of the scene (or of one `shard` of them) in precision `T`
 /// with `threads` workers (0: all cores); `progress` is called with the number of pairs done so
 /// far.

@@ -9,6 +9,7 @@
 
 pub mod build;
 pub mod bvh;
+pub mod fold;
 pub mod matrix;
 pub mod mesh;
 pub mod model;
