@@ -274,3 +274,29 @@ fn help_and_no_subcommand() {
     let out = pdm(&[]);
     assert!(!out.status.success());
 }
+
+/// `pdm-ff validate` with no options: the paper's printed values, our paper mode and our
+/// accurate mode side by side at the 280-patch grid. Each row's last column is the accurate
+/// mode's worst relative error against the references (1/6, the independent cube reference,
+/// 1); the paper mode's plain sums for touching patches are visibly off.
+#[test]
+fn no_options_prints_the_overview_at_280_patches() {
+    let out = pdm(&["validate"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("280 patches (sphere 8x8, faces 6x6)"), "{text}");
+    let err = |token: &str| token.parse::<f64>().unwrap_or_else(|_| panic!("{token} in {text}"));
+    for label in
+        ["sphere -> face 1, 6", "sphere -> face 2-5", "face -> adjacent (12)", "face -> opposite (3)", "face sums (6)"]
+    {
+        let line = text.lines().find(|l| l.starts_with(label)).unwrap_or_else(|| panic!("no {label}: {text}"));
+        let tokens: Vec<&str> = line[label.len()..].split_whitespace().collect();
+        assert_eq!(tokens.len(), 7, "{line}");
+        let (paper_mode, accurate) = (err(tokens[4]), err(tokens[6]));
+        assert!(accurate < 5e-6, "{line}");
+        if label.starts_with("face -> adjacent") || label.starts_with("face sums") {
+            assert!(paper_mode > 1e-2, "{line}");
+        }
+    }
+    assert!(text.lines().any(|l| l.starts_with("time") && l.contains("26 min 18 s")), "{text}");
+}

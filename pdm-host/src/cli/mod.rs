@@ -246,7 +246,26 @@ fn reference(radius: f64, recompute: bool) -> validate::Reference {
     r
 }
 
+/// Accurate mode's orders in the overview (`pdm-ff validate` with no options): the cheapest
+/// fixed setting that keeps every value of the 280-patch scene within a few 1e-6 in about a
+/// second on two cores (BENCHMARKS.md).
+const OVERVIEW_ORDER: usize = 4;
+/// See [`OVERVIEW_ORDER`].
+const OVERVIEW_SINGULAR_ORDER: usize = 6;
+
 fn run_validate(args: &ValidateArgs) -> ExitCode {
+    // No option that picks a method, grid, radius, precision or format: the overview.
+    let overview = args.mode.is_none()
+        && args.tolerance.is_none()
+        && args.patches.is_none()
+        && args.sphere_grid.is_none()
+        && args.face_grid.is_none()
+        && args.order.is_none()
+        && args.repeat.is_none()
+        && args.precision == PrecisionArg::F64
+        && args.format == Format::Table
+        && args.sphere_radius == 1.0
+        && !args.recompute_reference;
     let mode = match (args.mode, args.tolerance) {
         (Some(ModeArg::Paper), _) | (None, None) => Mode::Paper,
         (Some(ModeArg::Accurate), _) | (None, Some(_)) => Mode::Accurate,
@@ -293,33 +312,58 @@ fn run_validate(args: &ValidateArgs) -> ExitCode {
         PrecisionArg::F32 => &[validate::Precision::F32],
         PrecisionArg::Both => &[validate::Precision::F64, validate::Precision::F32],
     };
-    let units = validate::compute::work_units(&config) * (repeat * precisions.len()) as u64;
-    let bar = progress::Bar::new(units);
-    let mut outcomes: Vec<Outcome> = Vec::new();
-    for &p in precisions {
-        let result = match p {
-            validate::Precision::F64 => validate::run::<f64>(&config, repeat, &bar),
-            validate::Precision::F32 => validate::run::<f32>(&config, repeat, &bar),
-        };
-        match result {
-            Ok(o) => outcomes.push(o),
-            Err(e) => {
-                bar.finish();
-                eprintln!("error: {e}");
-                let code = if matches!(e, ValidateError::BadSetting(_)) { EXIT_USAGE } else { EXIT_FAILURE };
-                return ExitCode::from(code);
+    let patches = args.patches;
+    let run = |config: RunConfig, repeat: usize, precisions: &[validate::Precision]| -> Result<Report, ExitCode> {
+        let units = validate::compute::work_units(&config) * (repeat * precisions.len()) as u64;
+        let bar = progress::Bar::new(units);
+        let mut outcomes: Vec<Outcome> = Vec::new();
+        for &p in precisions {
+            let result = match p {
+                validate::Precision::F64 => validate::run::<f64>(&config, repeat, &bar),
+                validate::Precision::F32 => validate::run::<f32>(&config, repeat, &bar),
+            };
+            match result {
+                Ok(o) => outcomes.push(o),
+                Err(e) => {
+                    bar.finish();
+                    eprintln!("error: {e}");
+                    let code = if matches!(e, ValidateError::BadSetting(_)) { EXIT_USAGE } else { EXIT_FAILURE };
+                    return Err(ExitCode::from(code));
+                }
             }
         }
+        bar.finish();
+        Ok(Report {
+            config,
+            patches,
+            repeat,
+            threads,
+            outcomes,
+            reference: reference.clone(),
+            paper: PaperValues::for_grid(config.sphere_patches(), config.face_grid, config.radius),
+        })
+    };
+    if overview {
+        // The paper's 280-patch grid, once as the paper computed it and once as accurately as
+        // about a second allows.
+        let grid = RunConfig { sphere_grid: (8, 8), face_grid: 6, ..config };
+        let paper_mode = RunConfig { mode: Mode::Paper, order: 5, ..grid };
+        let accurate =
+            RunConfig { mode: Mode::Accurate, order: OVERVIEW_ORDER, singular_order: OVERVIEW_SINGULAR_ORDER, ..grid };
+        let (paper_report, accurate_report) = match (run(paper_mode, 3, precisions), run(accurate, 1, precisions)) {
+            (Ok(p), Ok(a)) => (p, a),
+            (Err(code), _) | (_, Err(code)) => return code,
+        };
+        let text = validate::report::overview(&paper_report, &accurate_report);
+        let mut stdout = std::io::stdout().lock();
+        if stdout.write_all(text.as_bytes()).and_then(|()| stdout.flush()).is_err() {
+            return ExitCode::from(EXIT_FAILURE);
+        }
+        return ExitCode::SUCCESS;
     }
-    bar.finish();
-    let report = Report {
-        config,
-        patches: args.patches,
-        repeat,
-        threads,
-        outcomes,
-        reference,
-        paper: PaperValues::for_grid(config.sphere_patches(), config.face_grid, config.radius),
+    let report = match run(config, repeat, precisions) {
+        Ok(r) => r,
+        Err(code) => return code,
     };
     let text = match args.format {
         Format::Table => report.to_table(),
