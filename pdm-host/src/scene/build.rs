@@ -522,18 +522,6 @@ pub fn build_in(file: &SceneFile, base: &Path) -> Result<Scene, EntryError> {
                     pieces.push(Piece { geom, rect, grid });
                 }
                 let occludes = spec.occludes.unwrap_or(true);
-                if occludes && !pieces.iter().all(|p| p.rect == p.geom.domain()) {
-                    return fail(
-                        i,
-                        spec,
-                        "occludes",
-                        format!(
-                            "is true (the default), but pdm has no occluder for a part of a {} (a `theta` or `phi` \
-                         range); set `occludes = false` (exact only if it hides nothing between other surfaces)",
-                            spec.kind.name()
-                        ),
-                    );
-                }
                 let radiates = group_radiates && spec.radiates.unwrap_or(true);
                 if !radiates && !occludes {
                     return fail(

@@ -5,13 +5,14 @@
 use std::time::Instant;
 
 use pdm_kernel::{
-    adaptive_exchange, pair_exchange, Adaptive, AnyOccluder, Ball, Occluder as _, PairSettings, Patch, PdmError, Real,
-    Vec3, WithCapacity,
+    adaptive_exchange, pair_exchange, Adaptive, Ball, Occluder as _, PairSettings, Patch, PdmError, Real, Vec3,
+    WithCapacity,
 };
 use rayon::prelude::*;
 
 use super::build::{Scene, ScenePatch};
 use super::model::Kind;
+use super::part::{Part, SceneOccluder};
 use super::shape::{corners, occluder_of, Geom, Plane, Shape};
 use crate::validate::stack;
 
@@ -179,7 +180,7 @@ struct Context<'s, T> {
     scene: &'s Scene,
     shapes: Vec<Vec<Shape<T>>>,
     /// Per surface, one occluder per piece (empty: the surface does not occlude).
-    occluders: Vec<Vec<AnyOccluder<T>>>,
+    occluders: Vec<Vec<SceneOccluder<T>>>,
     info: Vec<PatchInfo<T>>,
     balls: Vec<(Vec3<f64>, f64)>,
     planes: Vec<Option<Plane>>,
@@ -203,7 +204,7 @@ enum Plan<T> {
     /// Zero by geometry.
     Skip,
     /// Integrate against these occluders.
-    Integrate(Vec<AnyOccluder<T>>),
+    Integrate(Vec<SceneOccluder<T>>),
 }
 
 impl<T: Real> Context<'_, T> {
@@ -349,11 +350,11 @@ impl<T: Real> Context<'_, T> {
                     max_order: ADAPTIVE_MAX_ORDER,
                     max_depth: stack::ADAPTIVE_MAX_DEPTH,
                 };
-                adaptive_exchange::<T, _, _, [AnyOccluder<T>], CAP>(&a, &b, settings, occluders.as_slice())
+                adaptive_exchange::<T, _, _, [SceneOccluder<T>], CAP>(&a, &b, settings, occluders.as_slice())
             }
             PairMethod::Order { order, singular_order } => {
                 let settings = PairSettings { order, singular_order, boundaries: true };
-                pair_exchange::<T, _, _, [AnyOccluder<T>], CAP>(&a, &b, settings, occluders.as_slice())
+                pair_exchange::<T, _, _, [SceneOccluder<T>], CAP>(&a, &b, settings, occluders.as_slice())
             }
         }
         .map_err(wrap)?;
@@ -426,9 +427,20 @@ fn compute_with<T: Real, const CAP: usize>(
     for (k, s) in all.iter().enumerate() {
         let first = scene.patches.iter().position(|p| p.surface == k).unwrap_or(0);
         let list = s.pieces.iter().map(|p| p.geom.shape::<T>()).collect::<Result<Vec<_>, _>>().map_err(at(first))?;
-        // Every piece of an occluding surface is one (the scene's builder refuses `occludes` on
-        // parts of surfaces, which have none).
-        occluders.push(if s.occludes { list.iter().filter_map(occluder_of).collect() } else { Vec::new() });
+        // Every piece of an occluding surface is one: a whole surface the kernel's occluder, a
+        // part of one (a `theta` or `phi` range) a `Part`.
+        let mut own = Vec::new();
+        if s.occludes {
+            for (piece, shape) in s.pieces.iter().zip(&list) {
+                let occluder = if piece.rect == piece.geom.domain() {
+                    occluder_of(shape).map(SceneOccluder::Whole)
+                } else {
+                    Part::new(piece.geom, piece.rect).map(SceneOccluder::Part)
+                };
+                own.push(occluder.ok_or(PdmError::Degenerate).map_err(at(first))?);
+            }
+        }
+        occluders.push(own);
         shapes.push(list);
     }
     let stands: Vec<bool> = (0..all.len())

@@ -13,6 +13,7 @@ pub mod fold;
 pub mod matrix;
 pub mod mesh;
 pub mod model;
+pub mod part;
 pub mod report;
 pub mod separate;
 pub mod shape;

@@ -160,7 +160,7 @@ pub fn parse(text: &str) -> Result<Vs3, (usize, String)> {
                             "{name} = {value} is View3D's integration setting: pdm's accuracy is set by --tolerance or --order"
                         )),
                         "emit" | "row" | "col" | "out" | "list" | "prjd" | "maxv" => {}
-                        _ => return Err((at, format!("unknown control word `{name}`"))),
+                        _ => out.notes.push(format!("unknown control word `{name}` ignored (as View3D does)")),
                     }
                 }
             }
@@ -523,6 +523,8 @@ End of data
         assert!(a.enclosure && b.enclosure);
         assert_eq!(a.title, "Pinney & Bean test 4");
         assert!(a.notes.iter().any(|n| n.contains("script-F")));
+        let odd = parse(&PINNEY_3.replace("emit=1", "emit=1 frobnicate=2")).unwrap();
+        assert!(odd.notes.iter().any(|n| n.contains("`frobnicate` ignored")), "{:?}", odd.notes);
         let (ga, gb) = (groups(&a).unwrap(), groups(&b).unwrap());
         assert_eq!(ga.len(), 8, "12 surfaces, 4 of them combined into 2 others");
         assert_eq!(gb.len(), 8);
@@ -579,7 +581,7 @@ E
             ("F 3\nV 2 0 0 0\n", 2, "out of sequence"),
             ("F 3\nV 1 0 0 x\n", 2, "`x`"),
             ("F 4\n", 1, "not supported"),
-            ("C foo=1\nF 3\n", 1, "control word"),
+            ("C encl=x\nF 3\n", 1, "`x`"),
             ("F 3\nQ 1\n", 2, "unknown line"),
             ("F 3\n! nothing\n", 2, "no surfaces"),
             ("F 3a\nS 1 R 0 0 0.9 a\n 0 0 0 0 90\n", 2, "ends before"),

@@ -1,0 +1,260 @@
+//! Occluders for parts of surfaces: a sphere zone or lune, a disk sector, part of a tube or a
+//! cone (a `theta` or `phi` range in the scene file). A segment is blocked where it crosses the
+//! whole surface at a point whose parameters lie in the part's rectangle: the crossings are the
+//! roots of the surface's quadric (or plane) along the segment, computed in f64, and each is
+//! mapped back to the surface's (t, s).
+//!
+//! These occluders have no closed-form visibility along lines (`line_polynomials` answers
+//! "not known"): the kernel's occluded paths bracket and bisect their edges instead.
+
+use pdm_kernel::{AnyOccluder, Ball, Occluder, Real, Vec3};
+
+use super::shape::{Geom, Rect};
+
+/// A part `rect` of the whole surface `geom`, with `whole` the whole surface's occluder (whose
+/// culling is conservative for the part).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Part<T> {
+    whole: AnyOccluder<T>,
+    geom: Geom,
+    rect: Rect,
+}
+
+/// The scene's occluders: a kernel occluder of a whole surface, or a part of one.
+// A part carries its surface's geometry beside the whole surface's occluder; the lists of a
+// pair hold a handful, copied once per pair, next to kernel work of microseconds or more.
+#[allow(clippy::large_enum_variant)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SceneOccluder<T> {
+    /// A whole surface.
+    Whole(AnyOccluder<T>),
+    /// A part of one.
+    Part(Part<T>),
+}
+
+fn f64v<T: Real>(v: Vec3<T>) -> Vec3<f64> {
+    pdm_kernel::vec3(v.x.to_f64(), v.y.to_f64(), v.z.to_f64())
+}
+
+/// Real roots of a τ² + 2b τ + c = 0, stable form (a cone's leading coefficient may be of
+/// either sign or zero).
+fn roots(a: f64, b: f64, c: f64) -> Option<(f64, f64)> {
+    if a < 0.0 {
+        return roots(-a, -b, -c);
+    }
+    if a == 0.0 {
+        return (b != 0.0).then(|| (-c / (2.0 * b), f64::NAN));
+    }
+    let disc = b * b - a * c;
+    if !(a > 0.0) || disc < 0.0 {
+        return None;
+    }
+    let q = -(b + b.signum() * disc.sqrt());
+    if q == 0.0 {
+        return Some((0.0, 0.0));
+    }
+    Some((q / a, c / q))
+}
+
+/// The angle of `v` in the frame (u, w), in [0, 2π).
+fn angle(v: Vec3<f64>, u: Vec3<f64>, w: Vec3<f64>) -> f64 {
+    let a = v.dot(w).atan2(v.dot(u));
+    if a < 0.0 {
+        a + 2.0 * core::f64::consts::PI
+    } else {
+        a
+    }
+}
+
+impl<T: Real> Part<T> {
+    /// The part `rect` of `geom` (a sphere, disk, cylinder or cone); `None` for other kinds or
+    /// when the kernel refuses the whole surface.
+    #[must_use]
+    pub fn new(geom: Geom, rect: Rect) -> Option<Self> {
+        if !matches!(geom, Geom::Sphere { .. } | Geom::Disk { .. } | Geom::Cylinder { .. } | Geom::Cone { .. }) {
+            return None;
+        }
+        let shape = geom.shape::<T>().ok()?;
+        let whole = super::shape::occluder_of(&shape)?;
+        Some(Self { whole, geom, rect })
+    }
+
+    /// The parameters (t, s) of a point `x` of the whole surface.
+    fn parameters(&self, x: Vec3<f64>) -> (f64, f64) {
+        match self.geom {
+            Geom::Sphere { center, radius, frame, .. } => {
+                let v = x - center;
+                ((v.dot(frame.axis) / radius).clamp(-1.0, 1.0).acos(), angle(v, frame.u, frame.w))
+            }
+            Geom::Disk { center, frame, .. } => {
+                let v = x - center;
+                let radial = v - frame.axis.scale(v.dot(frame.axis));
+                (radial.norm(), angle(v, frame.u, frame.w))
+            }
+            Geom::Cylinder { base, frame, .. } | Geom::Cone { base, frame, .. } => {
+                let v = x - base;
+                (angle(v, frame.u, frame.w), v.dot(frame.axis))
+            }
+            _ => (f64::NAN, f64::NAN),
+        }
+    }
+
+    /// The τ ∈ (0, 1) where the segment p + τ(q − p) meets the whole surface.
+    fn crossings(&self, p: Vec3<f64>, q: Vec3<f64>) -> [Option<f64>; 2] {
+        let d = q - p;
+        let quadric = |a: f64, b: f64, c: f64| match roots(a, b, c) {
+            Some((x, y)) => [Some(x), Some(y)],
+            None => [None, None],
+        };
+        match self.geom {
+            Geom::Sphere { center, radius, .. } => {
+                let f = p - center;
+                quadric(d.dot(d), f.dot(d), f.dot(f) - radius * radius)
+            }
+            Geom::Disk { center, frame, .. } => {
+                let (num, den) = (frame.axis.dot(center - p), frame.axis.dot(d));
+                [(den != 0.0).then(|| num / den), None]
+            }
+            Geom::Cylinder { base, frame, radius, .. } => {
+                let perp = |v: Vec3<f64>| v - frame.axis.scale(v.dot(frame.axis));
+                let (f, e) = (perp(p - base), perp(d));
+                quadric(e.dot(e), f.dot(e), f.dot(f) - radius * radius)
+            }
+            Geom::Cone { base, frame, base_radius, top_radius, height, .. } => {
+                // |x⊥|² = r(z)², r(z) = r₀ + k z, z = z₀ + τ z₁: a quadratic in τ.
+                let perp = |v: Vec3<f64>| v - frame.axis.scale(v.dot(frame.axis));
+                let (f, e) = (perp(p - base), perp(d));
+                let k = (top_radius - base_radius) / height;
+                let (z0, z1) = ((p - base).dot(frame.axis), d.dot(frame.axis));
+                let (r0, r1) = (base_radius + k * z0, k * z1);
+                quadric(e.dot(e) - r1 * r1, f.dot(e) - r0 * r1, f.dot(f) - r0 * r0)
+            }
+            _ => [None, None],
+        }
+    }
+}
+
+impl<T: Real> Occluder<T> for Part<T> {
+    /// The segment crosses the whole surface inside the open segment (away from its ends by
+    /// the kernel's relative `GEOMETRY_TOLERANCE`, as every occluder) at a point of the part.
+    fn blocks(&self, p: Vec3<T>, q: Vec3<T>) -> bool {
+        let (p, q) = (f64v(p), f64v(q));
+        let tol = T::GEOMETRY_TOLERANCE.to_f64();
+        let r = self.rect;
+        self.crossings(p, q).into_iter().flatten().any(|tau| {
+            if !(tau > tol && tau < 1.0 - tol) {
+                return false;
+            }
+            let (t, s) = self.parameters(p + (q - p).scale(tau));
+            t >= r.t0 && t <= r.t1 && s >= r.s0 && s <= r.s1
+        })
+    }
+    fn may_block_between(&self, a: &Ball<T>, b: &Ball<T>) -> bool {
+        self.whole.may_block_between(a, b)
+    }
+}
+
+impl<T: Real> Occluder<T> for SceneOccluder<T> {
+    fn blocks(&self, p: Vec3<T>, q: Vec3<T>) -> bool {
+        match self {
+            Self::Whole(o) => o.blocks(p, q),
+            Self::Part(o) => o.blocks(p, q),
+        }
+    }
+    fn may_block_between(&self, a: &Ball<T>, b: &Ball<T>) -> bool {
+        match self {
+            Self::Whole(o) => o.may_block_between(a, b),
+            Self::Part(o) => o.may_block_between(a, b),
+        }
+    }
+    fn line_polynomials(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut([T; 3])) -> bool {
+        match self {
+            Self::Whole(o) => o.line_polynomials(p, origin, direction, out),
+            Self::Part(_) => false,
+        }
+    }
+    fn hides_ball_from(&self, p: Vec3<T>, b: &Ball<T>) -> bool {
+        match self {
+            Self::Whole(o) => o.hides_ball_from(p, b),
+            Self::Part(_) => false,
+        }
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used, clippy::indexing_slicing)]
+mod tests {
+    use super::*;
+    use pdm_kernel::{vec3, Frame, Surface as _};
+    use rand::{RngExt, SeedableRng};
+    use rand_xoshiro::Xoshiro256StarStar;
+
+    fn kinds() -> Vec<Geom> {
+        let frame = Frame::from_axis(vec3(0.3, -0.2, 1.0)).unwrap();
+        let c = vec3(0.1, 0.2, -0.3);
+        vec![
+            Geom::Sphere { center: c, radius: 1.1, frame, inner: false },
+            Geom::Disk { center: c, frame, inner: 0.2, outer: 1.3 },
+            Geom::Cylinder { base: c, frame, radius: 0.9, height: 1.5, inner: false },
+            Geom::Cone { base: c, frame, base_radius: 1.2, top_radius: 0.4, height: 1.4, inner: true },
+        ]
+    }
+
+    /// The parameters found for a point of the surface are those it was made from, and a
+    /// segment through that point is blocked by a small part around it and by no part beside.
+    #[test]
+    fn crossings_map_back_to_their_parameters() {
+        let mut rng = Xoshiro256StarStar::seed_from_u64(3);
+        for geom in kinds() {
+            let shape = geom.shape::<f64>().unwrap();
+            let d = geom.domain();
+            for _ in 0..300 {
+                let t = d.t0 + (d.t1 - d.t0) * (0.05 + 0.9 * rng.random::<f64>());
+                let s = d.s0 + (d.s1 - d.s0) * (0.05 + 0.9 * rng.random::<f64>());
+                let (x, n) = shape.point_and_normal(t, s);
+                let part = Part::<f64>::new(geom, d).unwrap();
+                let (pt, ps) = part.parameters(x);
+                assert!((pt - t).abs() < 1e-9 && (ps - s).abs() < 1e-9, "{geom:?}: ({t}, {s}) -> ({pt}, {ps})");
+                // A short segment across the surface at x, tilted off the normal.
+                let n = n.scale(1.0 / n.norm());
+                let tilt = vec3(0.2 * rng.random::<f64>(), 0.1, -0.15);
+                let (p, q) = (x - (n + tilt).scale(0.01), x + (n - tilt).scale(0.01));
+                let h = 0.01 * (d.t1 - d.t0);
+                let k = 0.01 * (d.s1 - d.s0);
+                let around = Part::<f64>::new(geom, Rect { t0: t - h, t1: t + h, s0: s - k, s1: s + k }).unwrap();
+                assert!(around.blocks(p, q), "{geom:?} at ({t}, {s})");
+                let beside =
+                    Part::<f64>::new(geom, Rect { t0: t + 2.0 * h, t1: t + 4.0 * h, s0: s - k, s1: s + k }).unwrap();
+                assert!(!beside.blocks(p, q), "{geom:?} at ({t}, {s})");
+                // The whole surface's part blocks as the kernel's occluder does.
+                assert_eq!(part.blocks(p, q), part.whole.blocks(p, q));
+            }
+        }
+    }
+
+    /// Two halves of a surface block a segment exactly when the whole does (random segments).
+    #[test]
+    fn halves_block_as_the_whole() {
+        let mut rng = Xoshiro256StarStar::seed_from_u64(8);
+        let mut point =
+            || vec3(rng.random::<f64>() * 4.0 - 2.0, rng.random::<f64>() * 4.0 - 2.0, rng.random::<f64>() * 4.0 - 2.0);
+        for geom in kinds() {
+            let d = geom.domain();
+            let whole = Part::<f64>::new(geom, d).unwrap();
+            let (tm, sm) = (0.37 * d.t0 + 0.63 * d.t1, 0.55 * d.s0 + 0.45 * d.s1);
+            let halves = [
+                Part::<f64>::new(geom, Rect { t1: tm, ..d }).unwrap(),
+                Part::<f64>::new(geom, Rect { t0: tm, s1: sm, ..d }).unwrap(),
+                Part::<f64>::new(geom, Rect { t0: tm, s0: sm, ..d }).unwrap(),
+            ];
+            let mut hits = 0;
+            for _ in 0..3000 {
+                let (p, q) = (point(), point());
+                let kernel = whole.whole.blocks(p, q);
+                assert_eq!(halves.iter().any(|h| h.blocks(p, q)), kernel, "{geom:?}: {p:?} {q:?}");
+                hits += usize::from(kernel);
+            }
+            assert!(hits > 300, "{geom:?}: {hits} blocked segments");
+        }
+    }
+}
