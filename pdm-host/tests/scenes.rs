@@ -227,10 +227,6 @@ fn bad_scenes_are_named_errors() {
         ),
         (format!("{rect}subdivide = [1000, 1000]\n"), &["more than 12000 patches"]),
         (format!("{rect}side = \"inner\"\n"), &["`side`", "front, back or both"]),
-        (
-            "[[surface]]\nname = \"s\"\nkind = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nphi = [0, 90]\n".to_string(),
-            &["`occludes`", "`phi`"],
-        ),
     ];
     for (text, needles) in &cases {
         let error = from_text(text, Format::Toml, "test.toml").expect_err(text).to_string();

@@ -99,37 +99,64 @@ impl<T: Real> Part<T> {
         }
     }
 
-    /// The τ ∈ (0, 1) where the segment p + τ(q − p) meets the whole surface.
-    fn crossings(&self, p: Vec3<f64>, q: Vec3<f64>) -> [Option<f64>; 2] {
+    /// The quadric of the whole surface along the segment p + τ(q − p): coefficients (a, b,
+    /// c) of a τ² + 2b τ + c, its value at q, and its scale (a squared radius); a plane is
+    /// the linear case a = 0 with its signed distances.
+    fn quadric(&self, p: Vec3<f64>, q: Vec3<f64>) -> Option<(f64, f64, f64, f64, f64)> {
         let d = q - p;
-        let quadric = |a: f64, b: f64, c: f64| match roots(a, b, c) {
-            Some((x, y)) => [Some(x), Some(y)],
-            None => [None, None],
-        };
-        match self.geom {
+        Some(match self.geom {
             Geom::Sphere { center, radius, .. } => {
-                let f = p - center;
-                quadric(d.dot(d), f.dot(d), f.dot(f) - radius * radius)
-            }
-            Geom::Disk { center, frame, .. } => {
-                let (num, den) = (frame.axis.dot(center - p), frame.axis.dot(d));
-                [(den != 0.0).then(|| num / den), None]
+                let (f, g) = (p - center, q - center);
+                let r2 = radius * radius;
+                (d.dot(d), f.dot(d), f.dot(f) - r2, g.dot(g) - r2, r2)
             }
             Geom::Cylinder { base, frame, radius, .. } => {
                 let perp = |v: Vec3<f64>| v - frame.axis.scale(v.dot(frame.axis));
-                let (f, e) = (perp(p - base), perp(d));
-                quadric(e.dot(e), f.dot(e), f.dot(f) - radius * radius)
+                let (f, e, g) = (perp(p - base), perp(d), perp(q - base));
+                let r2 = radius * radius;
+                (e.dot(e), f.dot(e), f.dot(f) - r2, g.dot(g) - r2, r2)
             }
             Geom::Cone { base, frame, base_radius, top_radius, height, .. } => {
                 // |x⊥|² = r(z)², r(z) = r₀ + k z, z = z₀ + τ z₁: a quadratic in τ.
                 let perp = |v: Vec3<f64>| v - frame.axis.scale(v.dot(frame.axis));
-                let (f, e) = (perp(p - base), perp(d));
+                let (f, e, g) = (perp(p - base), perp(d), perp(q - base));
                 let k = (top_radius - base_radius) / height;
                 let (z0, z1) = ((p - base).dot(frame.axis), d.dot(frame.axis));
                 let (r0, r1) = (base_radius + k * z0, k * z1);
-                quadric(e.dot(e) - r1 * r1, f.dot(e) - r0 * r1, f.dot(f) - r0 * r0)
+                let rq = r0 + r1;
+                let scale = base_radius.max(top_radius).powi(2);
+                (e.dot(e) - r1 * r1, f.dot(e) - r0 * r1, f.dot(f) - r0 * r0, g.dot(g) - rq * rq, scale)
             }
-            _ => [None, None],
+            _ => return None,
+        })
+    }
+
+    /// The τ ∈ (0, 1) where the segment p + τ(q − p) crosses the whole surface. An end point
+    /// on the surface (within the rounding of the precision `T` that placed it, as the
+    /// kernel's occluders decide) is a root at exactly 0 or 1, which does not count: a segment
+    /// from a point of the surface meets it again only at the other root.
+    fn crossings(&self, p: Vec3<f64>, q: Vec3<f64>) -> [Option<f64>; 2] {
+        let on = |value: f64, scale: f64| {
+            value.abs() <= (64.0 * T::EPSILON.to_f64() + 16.0 * T::ELEMENTARY_ERROR.to_f64()) * scale
+        };
+        if let Geom::Disk { center, frame, outer, .. } = self.geom {
+            let (dp, dq) = (frame.axis.dot(p - center), frame.axis.dot(q - center));
+            if on(dp, outer) || on(dq, outer) || dp == dq {
+                return [None, None];
+            }
+            return [Some(dp / (dp - dq)), None];
+        }
+        let Some((a, b, c, c_q, scale)) = self.quadric(p, q) else { return [None, None] };
+        match (on(c, scale), on(c_q, scale)) {
+            (true, true) => [None, None],
+            // Roots 0 and −2b/a.
+            (true, false) => [(a != 0.0).then(|| -2.0 * b / a), None],
+            // Roots 1 and c/a (the product of the roots).
+            (false, true) => [(a != 0.0).then(|| c / a), None],
+            (false, false) => match roots(a, b, c) {
+                Some((x, y)) => [Some(x), Some(y)],
+                None => [None, None],
+            },
         }
     }
 }
@@ -230,6 +257,43 @@ mod tests {
                 assert_eq!(part.blocks(p, q), part.whole.blocks(p, q));
             }
         }
+    }
+
+    /// A segment that starts on the part itself and leaves it along the normal is not blocked
+    /// by it, in f32 far from the origin too (the end point is on the surface only to f32's
+    /// rounding); one that enters a closed sphere's zone from a point on it is, at its far side.
+    #[test]
+    fn segments_from_the_surface_itself() {
+        let frame = Frame::from_axis(vec3(0.0, 0.0, 1.0)).unwrap();
+        let far = vec3(50.0, 0.0, 0.0);
+        let geoms = [
+            Geom::Sphere { center: far, radius: 1.0, frame, inner: false },
+            Geom::Cylinder { base: far, frame, radius: 0.7, height: 1.0, inner: false },
+            Geom::Cone { base: far, frame, base_radius: 0.8, top_radius: 0.3, height: 1.0, inner: false },
+            Geom::Disk { center: far, frame, inner: 0.0, outer: 1.0 },
+        ];
+        for geom in geoms {
+            let d = geom.domain();
+            let rect = Rect { t0: d.t0 + 0.1 * (d.t1 - d.t0), t1: d.t1 - 0.1 * (d.t1 - d.t0), s0: 0.1, s1: 3.0 };
+            let shape = geom.shape::<f32>().unwrap();
+            let part = Part::<f32>::new(geom, rect).unwrap();
+            for i in 1..20 {
+                for j in 1..20 {
+                    let t = rect.t0 + (rect.t1 - rect.t0) * f64::from(i) / 20.0;
+                    let s = rect.s0 + (rect.s1 - rect.s0) * f64::from(j) / 20.0;
+                    let (x, n) = shape.point_and_normal(t as f32, s as f32);
+                    let n = n.scale(0.3 / n.norm());
+                    assert!(!part.blocks(x, x + n), "{geom:?} at ({t}, {s})");
+                    assert!(!part.blocks(x + n, x), "{geom:?} at ({t}, {s})");
+                }
+            }
+        }
+        // Into the sphere from its zone: the segment leaves through the opposite side.
+        let sphere = Geom::Sphere { center: far, radius: 1.0, frame, inner: false };
+        let whole = Part::<f64>::new(sphere, sphere.domain()).unwrap();
+        let top = vec3(50.0, 0.0, 1.0);
+        assert!(whole.blocks(top, vec3(50.0, 0.0, -2.0)));
+        assert!(!whole.blocks(top, vec3(50.0, 0.0, -0.5)));
     }
 
     /// Two halves of a surface block a segment exactly when the whole does (random segments).

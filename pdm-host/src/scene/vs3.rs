@@ -79,10 +79,14 @@ pub struct Vs3Group {
     pub radiates: bool,
 }
 
-/// A line of the file cut into words, comments (`!`, `/`) removed.
+/// A line of the file cut into words (blanks and commas separate them), comments removed: from
+/// a `!` anywhere, or from a word that starts with `/`.
 fn words(line: &str) -> Vec<&str> {
-    let data = line.split(['!', '/']).next().unwrap_or("");
-    data.split_whitespace().collect()
+    let data = line.split('!').next().unwrap_or("");
+    data.split(|c: char| c.is_whitespace() || c == ',')
+        .filter(|w| !w.is_empty())
+        .take_while(|w| !w.starts_with('/'))
+        .collect()
 }
 
 fn number<T: std::str::FromStr>(word: Option<&&str>, what: &str, line: usize) -> Result<T, (usize, String)> {
@@ -220,6 +224,8 @@ pub fn parse(text: &str) -> Result<Vs3, (usize, String)> {
                             values.push(real(Some(&word), &format!("surface {n}'s geometry"), k)?);
                         }
                     }
+                    // As View3D, the numbers the shape needs; the rest of the line is ignored.
+                    values.truncate(needed);
                     blast_corners(shape.as_deref() == Some("R"), &values)
                 } else {
                     let mut corners = Vec::new();
@@ -299,18 +305,30 @@ fn cut_holes(base: &Vs3Surface, holes: &[&Vs3Surface]) -> Result<Vec<Vec<Vec3<f6
     let unit = normal.scale(1.0 / area2);
     let origin = base.vertices.first().copied().unwrap_or(vec3(0.0, 0.0, 0.0));
     let size = base.vertices.iter().map(|p| (*p - origin).norm()).fold(0.0, f64::max);
-    let u = base.vertices.get(1).map_or(vec3(1.0, 0.0, 0.0), |p| (*p - origin).scale(1.0 / (*p - origin).norm()));
-    let w = unit.cross(u);
+    let frame = pdm_kernel::Frame::from_axis(unit)
+        .map_err(|_| (base.line, format!("surface {} has zero area", base.number)))?;
+    let (u, w) = (frame.u, frame.w);
     let flat = |p: Vec3<f64>| [u.dot(p - origin), w.dot(p - origin)];
     let mut coords: Vec<f64> = base.vertices.iter().flat_map(|p| flat(*p)).collect();
     let mut starts = Vec::new();
     let mut hole_area2 = 0.0;
     for hole in holes {
         let n = newell(&hole.vertices);
-        if (n - unit.scale(n.norm())).norm() > 1e-9 * n.norm() && (n + unit.scale(n.norm())).norm() > 1e-9 * n.norm() {
+        let same = (n - unit.scale(n.norm())).norm() <= 1e-9 * n.norm();
+        let opposite = (n + unit.scale(n.norm())).norm() <= 1e-9 * n.norm();
+        if !same && !opposite {
             return Err((
                 hole.line,
                 format!("surface {} is not in the plane of its base {}", hole.number, base.number),
+            ));
+        }
+        if hole.kind == Vs3Kind::Radiating && !same {
+            return Err((
+                hole.line,
+                format!(
+                    "subsurface {} faces the other way from its base {} (View3D requires the same)",
+                    hole.number, base.number
+                ),
             ));
         }
         for p in &hole.vertices {
@@ -362,8 +380,12 @@ pub fn groups(file: &Vs3) -> Result<Vec<Vs3Group>, (usize, String)> {
             return Err((s.line, format!("surface {}: masking surfaces (M) are not supported", s.number)));
         }
         if s.base != 0 {
-            let Some(b) = by_number(s.base).filter(|_| s.base < s.number) else {
-                return Err((s.line, format!("surface {}: base surface {} must come before it", s.number, s.base)));
+            // Bases come first, except obstructions, which View3D lists after every other surface.
+            let Some(b) = by_number(s.base).filter(|b| s.base < s.number || b.kind == Vs3Kind::Obstruction) else {
+                return Err((
+                    s.line,
+                    format!("surface {}: base surface {} must come before it (or be an obstruction)", s.number, s.base),
+                ));
             };
             if b.kind == Vs3Kind::Null {
                 return Err((s.line, format!("surface {}: a null surface cannot be a base", s.number)));
@@ -572,6 +594,29 @@ E
         let n = area_normal(&g[0].faces);
         assert!((n - vec3(0.0, 0.0, 10.75)).norm() < 1e-12, "{n:?}");
         assert!(g[0].faces.iter().all(|f| newell(f).z > 0.0 && f.len() == 3));
+    }
+
+    /// The reader follows View3D where files stray: commas between numbers, a `/` comment
+    /// after the data, extra numbers after a shape's, a window in an obstruction (listed
+    /// last), a base whose first two vertices coincide.
+    #[test]
+    fn what_view3d_accepts_is_read() {
+        let text = "F 3\nV 1, 0, 0, 0\nV 2 4 0 0 / a comment\nV 3 4 3 0\nV 4 0 3 0\nV 5 1 1 0\nV 6 2 1 0\nV 7 2 2 0\n\
+                    S 1 5 6 7 0 2 0 0.9 window\nO 2 1 2 3 4\nE\n";
+        let g = groups(&parse(text).unwrap()).unwrap();
+        assert_eq!(g.len(), 2);
+        assert!(!g[1].radiates && g[1].faces.len() > 1, "the window is cut out of the obstruction");
+        let blast = "F 3a\nS 1 T 0 0 0.9 t\n 0 0 0 0 0  0 0 1 0 0 1  0 0\nE\n";
+        let v = parse(blast).unwrap();
+        assert_eq!(v.surfaces[0].vertices.len(), 3);
+        let doubled = "F 3\nV 1 0 0 0\nV 2 1 0 0\nV 3 0 1 0\nV 4 .2 .2 0\nV 5 .4 .2 0\nV 6 .2 .4 0\n\
+                       S 1 1 1 2 3 0 0 .9 w\nS 2 4 5 6 0 1 0 .9 win\n";
+        let g = groups(&parse(doubled).unwrap()).unwrap();
+        assert_eq!(g.len(), 2);
+        let backwards = "F 3\nV 1 0 0 0\nV 2 1 0 0\nV 3 0 1 0\nV 4 .2 .2 0\nV 5 .4 .2 0\nV 6 .2 .4 0\n\
+                         S 1 1 2 3 0 0 0 .9 w\nS 2 4 6 5 0 1 0 .9 win\n";
+        let e = groups(&parse(backwards).unwrap()).unwrap_err();
+        assert!(e.1.contains("faces the other way"), "{e:?}");
     }
 
     #[test]
