@@ -109,8 +109,7 @@ pub fn load(path: &Path) -> Result<Groups, String> {
             let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
             let at = |(line, message): (usize, String)| format!("{}:{line}: {message}", path.display());
             let file = super::vs3::parse(&text).map_err(at)?;
-            let groups = super::vs3::groups(&file).map_err(at)?;
-            Ok(groups.into_iter().map(|g| Group { name: g.name, faces: g.faces, radiates: g.radiates }).collect())
+            super::vs3::groups(&file).map_err(at)
         }
         _ => Err(format!("{}: unknown mesh format (use .obj, .stl or View3D's .vs3)", path.display())),
     }

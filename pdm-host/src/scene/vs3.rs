@@ -21,6 +21,8 @@
 
 use pdm_kernel::{vec3, Vec3};
 
+use super::mesh::Group;
+
 /// The kind of a View3D surface line.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Vs3Kind {
@@ -66,17 +68,6 @@ pub struct Vs3 {
     pub surfaces: Vec<Vs3Surface>,
     /// Control settings pdm does not use, in words.
     pub notes: Vec<String>,
-}
-
-/// A group of faces for the scene: one output surface.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Vs3Group {
-    /// The surface's name.
-    pub name: String,
-    /// Its faces (convex quadrilaterals, triangles), counter-clockwise about the radiating side.
-    pub faces: Vec<Vec<Vec3<f64>>>,
-    /// `false` for obstructions.
-    pub radiates: bool,
 }
 
 /// A line of the file cut into words (blanks and commas separate them), comments removed: from
@@ -373,7 +364,7 @@ fn cut_holes(base: &Vs3Surface, holes: &[&Vs3Surface]) -> Result<Vec<Vec<Vec3<f6
 
 /// The file's surfaces as the scene's groups: one per output surface (combinations joined,
 /// subsurfaces and null surfaces cut out of their bases), then the obstructions.
-pub fn groups(file: &Vs3) -> Result<Vec<Vs3Group>, (usize, String)> {
+pub fn groups(file: &Vs3) -> Result<Vec<Group>, (usize, String)> {
     let by_number = |n: usize| file.surfaces.get(n.wrapping_sub(1));
     for s in &file.surfaces {
         if s.kind == Vs3Kind::Mask {
@@ -421,14 +412,22 @@ pub fn groups(file: &Vs3) -> Result<Vec<Vs3Group>, (usize, String)> {
             return Err((s.line, format!("surface {} {problem}", s.number)));
         }
     }
-    let mut out: Vec<Vs3Group> = Vec::new();
+    let mut out: Vec<Group> = Vec::new();
     let mut index_of = vec![usize::MAX; file.surfaces.len() + 1];
+    // Each surface's subsurfaces and null surfaces, by the base's number (one pass, not one per
+    // surface: building models run to thousands of surfaces).
+    let mut holes_of: Vec<Vec<&Vs3Surface>> = vec![Vec::new(); file.surfaces.len() + 1];
+    for h in file.surfaces.iter().filter(|h| h.base != 0) {
+        if let Some(list) = holes_of.get_mut(h.base) {
+            list.push(h);
+        }
+    }
     for s in &file.surfaces {
-        let holes: Vec<&Vs3Surface> = file.surfaces.iter().filter(|h| h.base == s.number).collect();
-        let faces = if holes.is_empty() { vec![s.vertices.clone()] } else { cut_holes(s, &holes)? };
+        let holes = holes_of.get(s.number).map_or(&[][..], Vec::as_slice);
+        let faces = if holes.is_empty() { vec![s.vertices.clone()] } else { cut_holes(s, holes)? };
         match s.kind {
             Vs3Kind::Null | Vs3Kind::Mask => {}
-            Vs3Kind::Obstruction => out.push(Vs3Group { name: s.name.clone(), faces, radiates: false }),
+            Vs3Kind::Obstruction => out.push(Group { name: s.name.clone(), faces, radiates: false }),
             Vs3Kind::Radiating if s.combine != 0 => {
                 let Some(group) = index_of.get(s.combine).and_then(|&g| out.get_mut(g)) else {
                     return Err((
@@ -453,7 +452,7 @@ pub fn groups(file: &Vs3) -> Result<Vec<Vs3Group>, (usize, String)> {
                 if let Some(slot) = index_of.get_mut(s.number) {
                     *slot = out.len();
                 }
-                out.push(Vs3Group { name: s.name.clone(), faces, radiates: true });
+                out.push(Group { name: s.name.clone(), faces, radiates: true });
             }
         }
     }
