@@ -76,6 +76,7 @@ fn bench_pairs(c: &mut Criterion) {
     }
     group.finish();
     near_flat(c);
+    sphere_cells(c);
 }
 
 fn near_flat(c: &mut Criterion) {
@@ -106,6 +107,42 @@ fn near_flat(c: &mut Criterion) {
         });
         group.bench_with_input(BenchmarkId::new("disk-wall-0.1", order), &order, |bench, _| {
             bench.iter(|| pair_exchange::<f64, _, _, _, 256>(black_box(&pd), black_box(&pw), s, &()).unwrap().value);
+        });
+    }
+    group.finish();
+}
+
+/// A cell of the unit sphere (φ ∈ [π/2, 3π/4], θ ∈ [0, π/2]) against the floor cell of the
+/// paper's cube below it (z = −3, x ∈ [1, 3], y ∈ [−1, 1]): with the sphere as occluder (the
+/// boundary path, outer patch split 3 × 3) and without (the pair straddles the back-face cut);
+/// and a cell of the bottom cap against a small floor cell (the plain sum). The same pairs as
+/// the firmware's `pair_stack` example, here in f64. The value printed is A·F; no closed form.
+fn sphere_cells(c: &mut Criterion) {
+    use pdm_kernel::{ParamRect, Sphere};
+    use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
+    let sphere = Sphere::outer(vec3(0.0, 0.0, 0.0), 1.0).unwrap();
+    let floor = Parallelogram::new(vec3(-3.0, -3.0, -3.0), vec3(6.0, 0.0, 0.0), vec3(0.0, 6.0, 0.0)).unwrap();
+    let side = Patch::new(&sphere, ParamRect::new(FRAC_PI_2, 3.0 * FRAC_PI_4, 0.0, FRAC_PI_2).unwrap()).unwrap();
+    let cap = Patch::new(&sphere, ParamRect::new(3.0 * FRAC_PI_4, PI, 0.0, FRAC_PI_2).unwrap()).unwrap();
+    let cell = Patch::new(&floor, ParamRect::new(2.0 / 3.0, 1.0, 1.0 / 3.0, 2.0 / 3.0).unwrap()).unwrap();
+    let small = Patch::new(&floor, ParamRect::new(0.45, 0.55, 0.45, 0.55).unwrap()).unwrap();
+    let mut group = c.benchmark_group("sphere-cell");
+    for order in [5, 8] {
+        let s = PairSettings { order, singular_order: order, boundaries: true };
+        let occluded = pair_exchange::<f64, _, _, _, 64>(&side, &cell, s, &sphere).unwrap().value;
+        let straddling = pair_exchange::<f64, _, _, _, 64>(&side, &cell, s, &()).unwrap().value;
+        let plain = pair_exchange::<f64, _, _, _, 64>(&cap, &small, s, &()).unwrap().value;
+        eprintln!("order {order}: occluded {occluded:.16e}, straddling {straddling:.16e}, plain {plain:.16e}");
+        group.bench_with_input(BenchmarkId::new("occluded", order), &order, |bench, _| {
+            bench.iter(|| {
+                pair_exchange::<f64, _, _, _, 64>(black_box(&side), black_box(&cell), s, &sphere).unwrap().value
+            });
+        });
+        group.bench_with_input(BenchmarkId::new("straddling", order), &order, |bench, _| {
+            bench.iter(|| pair_exchange::<f64, _, _, _, 64>(black_box(&side), black_box(&cell), s, &()).unwrap().value);
+        });
+        group.bench_with_input(BenchmarkId::new("plain", order), &order, |bench, _| {
+            bench.iter(|| pair_exchange::<f64, _, _, _, 64>(black_box(&cap), black_box(&small), s, &()).unwrap().value);
         });
     }
     group.finish();

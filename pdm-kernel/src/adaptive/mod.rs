@@ -87,7 +87,6 @@
 
 use crate::error::PdmError;
 pub use crate::estimate::Estimate;
-use crate::form_factor::exchange_unchecked;
 use crate::integrand::mutually_facing;
 use crate::patch::Patch;
 use crate::real::Real;

@@ -20,8 +20,8 @@ where
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
-    let probe = PatchSamples::<T, CAP>::new(a, 2)?;
-    let probe_b = PatchSamples::<T, CAP>::new(b, 2)?;
+    let mut pair = crate::pair::PairContext::<T, SA, SB, O, CAP>::new(a, b, occluders);
+    let (probe, probe_b) = pair.samples(2)?;
     let (ba, bb) = (probe.bounds(), probe_b.bounds());
     let size = (ba.radius + bb.radius).max(T::MIN_POSITIVE);
     let dist = ((ba.center - bb.center).norm() - ba.radius - bb.radius).max(T::ZERO);
@@ -34,18 +34,16 @@ where
         p += 1;
     }
     let p = p.min(settings.max_order);
-    let sa = PatchSamples::<T, CAP>::new(a, p)?;
-    let sb = PatchSamples::<T, CAP>::new(b, p)?;
-    let (ball_a, ball_b) = (a.enclosing_ball(), b.enclosing_ball());
+    pair.samples(p)?;
+    let (ball_a, ball_b) = pair.balls();
     // Patches closer than their size: the plain rule's nodes do not resolve the kernel's peak,
     // and two orders can agree by accident (a separate pair folded to 33° with the gap a
     // quarter of its size: orders 10 and 12 agreed to 9e-7 with the value 4.4e-6 off). The
     // boundary path refines the inner patch towards each close outer point, and its estimate
     // compares the outer patch whole and split.
     let occluded = occluders.may_block_between(&ball_a, &ball_b);
-    let across = occluded || crate::pair::near(&ball_a, &ball_b) || straddles_curvature_cut(&sa, &sb);
-    let swap = across
-        && if occluded { crate::pair::occluded_outer_is_b(a, b) } else { crate::pair::outer_is_b(a, b, &sa, &sb) };
+    let across = occluded || crate::pair::near(&ball_a, &ball_b) || pair.straddles(p)?;
+    let swap = across && if occluded { pair.occluded_outer_is_b() } else { pair.outer_is_b(p)? };
     Ok((p, across, swap))
 }
 
@@ -63,9 +61,7 @@ where
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
-    let sa = PatchSamples::<T, CAP>::new(a, order)?;
-    let sb = PatchSamples::<T, CAP>::new(b, order)?;
-    Ok((exchange_unchecked(&sa, &sb, occluders)?, (sa.len() * sb.len()) as u64))
+    crate::pair::PairContext::<T, SA, SB, O, CAP>::new(a, b, occluders).plain(order, occluders)
 }
 
 pub(super) fn separate<T, SA, SB, O, const CAP: usize>(
@@ -118,18 +114,15 @@ where
     while p + 1 < settings.max_order && T::from_usize(p) < digits + T::TWO {
         p += 1;
     }
-    let r = a.rect();
+    // One pair context: b's samples are shared by the whole patch a and its quarters at each
+    // order; a's buffer is re-filled for each.
+    let mut pair = crate::pair::PairContext::<T, SA, SB, O, CAP>::new(a, b, occluders);
     let mut evaluations = 0u64;
     let mut at = |order: usize| -> Result<(T, T), PdmError> {
-        let (whole, n, _, _) = crate::boundary::boundary_unchecked::<T, SA, SB, O, CAP>(a, b, order, occluders)?;
+        let (whole, n) = pair.boundary(order, false, 1, occluders)?;
         evaluations = evaluations.saturating_add(n);
-        let mut quarters = T::ZERO;
-        for k in 0..4 {
-            let child = Patch::new(a.surface(), r.cell(k / 2, k % 2, 2, 2))?;
-            let (v, n, _, _) = crate::boundary::boundary_unchecked::<T, SA, SB, O, CAP>(&child, b, order, occluders)?;
-            quarters += v;
-            evaluations = evaluations.saturating_add(n);
-        }
+        let (quarters, n) = pair.boundary(order, false, 2, occluders)?;
+        evaluations = evaluations.saturating_add(n);
         Ok((whole, quarters))
     };
     let (whole, quarters) = at(p)?;

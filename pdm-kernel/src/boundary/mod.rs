@@ -135,10 +135,32 @@ where
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
-    let count = core::cell::Cell::new(0u64);
     let mut outer = PatchSamples::<T, CAP>::new(a, order)?;
     let area_a = outer.area();
     let inner_samples = PatchSamples::<T, CAP>::new(b, order)?; // validates b (area, finiteness)
+    let (value, count) = boundary_sum(a, &mut outer, b, &inner_samples, order, occluders)?;
+    Ok((value, count, area_a, inner_samples.area()))
+}
+
+/// The boundary path on samples the caller holds (the pair context's two buffers): `outer`
+/// holds a's samples and `inner_samples` b's, both at `order` (b's also validate it: area,
+/// finiteness). `outer` is re-filled in place where a is cut into cells (a very near pair), so
+/// the pair needs no third buffer. (A_a·F_{a→b}, evaluations), finite but not bounds-checked.
+pub(crate) fn boundary_sum<T, SA, SB, O, const CA: usize, const CB: usize>(
+    a: &Patch<'_, T, SA>,
+    outer: &mut PatchSamples<T, CA>,
+    b: &Patch<'_, T, SB>,
+    inner_samples: &PatchSamples<T, CB>,
+    order: usize,
+    occluders: &O,
+) -> Result<(T, u64), PdmError>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
+    let count = core::cell::Cell::new(0u64);
     let r = b.rect();
     let surface = b.surface();
     // Closed form when b is a parallelogram and every occluder can give its polynomials.
@@ -185,13 +207,13 @@ where
     if n_cells > 1 {
         for cell in cells.iter().take(n_cells) {
             outer.fill(&Patch::new(a.surface(), *cell)?, order, order)?;
-            total += outer_sum(&outer, &inner, &inner_samples, &inner_bounds)?;
+            total += outer_sum(outer, &inner, inner_samples, &inner_bounds)?;
         }
     } else {
-        total = outer_sum(&outer, &inner, &inner_samples, &inner_bounds)?;
+        total = outer_sum(outer, &inner, inner_samples, &inner_bounds)?;
     }
     let value = crate::bounds::finite(total * T::FRAC_1_PI)?;
-    Ok((value, count.get(), area_a, inner_samples.area()))
+    Ok((value, count.get()))
 }
 
 /// Most cells into which [`outer_cells`] cuts the outer patch (each costs one outer rule).
@@ -264,10 +286,10 @@ where
 }
 
 /// The outer sum Σ w_p J(p) over one set of outer samples (see [`boundary_unchecked`]).
-fn outer_sum<T, SB, O, const CAP: usize>(
-    outer: &PatchSamples<T, CAP>,
+fn outer_sum<T, SB, O, const CA: usize, const CB: usize>(
+    outer: &PatchSamples<T, CA>,
     inner: &Inner<'_, T, SB, O>,
-    inner_samples: &PatchSamples<T, CAP>,
+    inner_samples: &PatchSamples<T, CB>,
     inner_bounds: &Ball<T>,
 ) -> Result<T, PdmError>
 where

@@ -11,8 +11,10 @@ pub(crate) fn near<T: Real>(a: &crate::samples::Ball<T>, b: &crate::samples::Bal
 }
 
 /// Whether the Gauss rules of order `order` resolve the pair
-/// ([`crate::form_factor::samples_resolved`]).
+/// ([`crate::form_factor::samples_resolved`]), for a caller without a pair context (the
+/// tolerance mode's recursion, which keeps no sample buffer in its own frames).
 #[cfg(feature = "closed-form")]
+#[inline(never)]
 pub(crate) fn resolved<T, SA, SB, const CAP: usize>(
     a: &Patch<'_, T, SA>,
     b: &Patch<'_, T, SB>,
@@ -23,9 +25,7 @@ where
     SA: Surface<T> + ?Sized,
     SB: Surface<T> + ?Sized,
 {
-    let sa = PatchSamples::<T, CAP>::new(a, order)?;
-    let sb = PatchSamples::<T, CAP>::new(b, order)?;
-    Ok(crate::form_factor::samples_resolved(&sa, order, &sb, order))
+    PairContext::<T, SA, SB, (), CAP>::new(a, b, &()).resolved(order)
 }
 
 /// Which patch of a pair an occluder may cut the boundary path should integrate outside
@@ -35,7 +35,13 @@ where
 /// patch's corners and edges, and jumps where an occluder cuts the outer patch itself; on the
 /// larger inner patch a shadow more often lies wholly inside, and the smaller outer patch is
 /// less often cut. It also makes the choice independent of the argument order.
-pub(crate) fn occluded_outer_is_b<T, SA, SB>(a: &Patch<'_, T, SA>, b: &Patch<'_, T, SB>) -> bool
+/// `ball_a`, `ball_b`: the patches' enclosing balls.
+pub(crate) fn occluded_outer_is_b<T, SA, SB>(
+    a: &Patch<'_, T, SA>,
+    b: &Patch<'_, T, SB>,
+    ball_a: &crate::samples::Ball<T>,
+    ball_b: &crate::samples::Ball<T>,
+) -> bool
 where
     T: Real,
     SA: Surface<T> + ?Sized,
@@ -45,7 +51,7 @@ where
     if flat_a != flat_b {
         return flat_a;
     }
-    b.enclosing_ball().radius < a.enclosing_ball().radius
+    ball_b.radius < ball_a.radius
 }
 
 /// Which patch of a separate, unoccluded pair the boundary path should integrate outside
@@ -146,32 +152,6 @@ pub(super) fn blind_points<T: Real, const CAP: usize>(
         .iter()
         .filter(|p| !inner.iter().any(|q| mutually_facing(p.point, p.unit_normal, q.point, q.unit_normal)))
         .count()
-}
-
-/// The boundary path with the outer patch split `OCCLUDED_OUTER_SPLIT`²: shadow edges
-/// crossing b make the outer integrand kink where they touch b's edges.
-pub(super) fn occluded<T, SA, SB, O, const CAP: usize>(
-    a: &Patch<'_, T, SA>,
-    b: &Patch<'_, T, SB>,
-    order: usize,
-    occluders: &O,
-) -> Result<(T, u64), PdmError>
-where
-    T: Real,
-    SA: Surface<T> + ?Sized,
-    SB: Surface<T> + ?Sized,
-    O: Occluder<T> + ?Sized,
-{
-    let (mut total, mut count) = (T::ZERO, 0u64);
-    let r = a.rect();
-    let n = OCCLUDED_OUTER_SPLIT;
-    for k in 0..n * n {
-        let child = Patch::new(a.surface(), r.cell(k / n, k % n, n, n))?;
-        let (v, c, _, _) = boundary_unchecked::<T, SA, SB, O, CAP>(&child, b, order, occluders)?;
-        total += v;
-        count = count.saturating_add(c);
-    }
-    Ok((total, count))
 }
 
 /// Whether the patch's surface is a parallelogram (an affine map), which the boundary path

@@ -39,11 +39,8 @@
 //! their seams), `choose.rs` (near, resolved, which patch goes outside), `flat.rs` (the contour
 //! form's pairs).
 
-use crate::adaptive::straddles_curvature_cut;
-use crate::boundary::boundary_unchecked;
 use crate::error::PdmError;
 use crate::estimate::Estimate;
-use crate::form_factor::exchange_unchecked;
 use crate::integrand::mutually_facing;
 use crate::patch::Patch;
 use crate::real::Real;
@@ -55,10 +52,12 @@ use crate::vec3::Vec3;
 use crate::visibility::Occluder;
 
 mod choose;
+mod context;
 #[cfg(feature = "closed-form")]
 mod flat;
 mod pieces;
 pub(crate) use choose::*;
+pub(crate) use context::*;
 #[cfg(feature = "closed-form")]
 pub(crate) use flat::*;
 pub(crate) use pieces::*;
@@ -253,6 +252,8 @@ where
 
 /// One piece pair by the method it needs, given its classification (`classify_near`):
 /// (value, evaluations, bound on the contour form's rounding — zero for the other methods).
+/// The pair's context (its two sample buffers) lives in this frame, which the recursion above
+/// does not keep while it descends.
 #[inline(never)]
 fn dispatch<T, SA, SB, O, const CAP: usize>(
     a: &Patch<'_, T, SA>,
@@ -267,7 +268,7 @@ where
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
-    let p4 = (settings.order as u64).saturating_pow(4);
+    let mut pair = PairContext::<T, SA, SB, O, CAP>::new(a, b, occluders);
     #[cfg(feature = "closed-form")]
     if settings.boundaries && contour_applies(adjacency) {
         match flat_pair(a, b, settings.order, occluders) {
@@ -283,7 +284,7 @@ where
             Some(Ok((v, _, r)))
                 if adjacency == Adjacency::Separate
                     && crate::bounds::cancels(v, r)
-                    && resolved::<T, SA, SB, CAP>(a, b, settings.order)? => {}
+                    && pair.resolved(settings.order)? => {}
             Some(result) => return result,
             None => {}
         }
@@ -295,34 +296,40 @@ where
             Ok(exact((touching_unchecked(a, b, adjacency, gap, settings.singular_order, occluders)?, count)))
         }
         Adjacency::Identical => crate::singular::identical_unchecked(a, settings.singular_order, occluders).map(exact),
-        Adjacency::Separate => {
-            let sa = PatchSamples::<T, CAP>::new(a, settings.order)?;
-            let sb = PatchSamples::<T, CAP>::new(b, settings.order)?;
-            if !settings.boundaries {
-                return Ok(exact((exchange_unchecked(&sa, &sb, occluders)?, p4)));
-            }
-            // The sample balls decide for the plain sum; the integrand is smooth only if no
-            // occluder cuts any segment between the patches (enclosing balls).
-            let may_occlude = occluders.may_block_between(&sa.bounds(), &sb.bounds())
-                || occluders.may_block_between(&a.enclosing_ball(), &b.enclosing_ball());
-            if may_occlude {
-                if !occluded_outer_is_b(a, b) {
-                    occluded::<T, SA, SB, O, CAP>(a, b, settings.order, occluders).map(exact)
-                } else {
-                    occluded::<T, SB, SA, O, CAP>(b, a, settings.order, occluders).map(exact)
-                }
-            } else if straddles_curvature_cut(&sa, &sb) || near(&a.enclosing_ball(), &b.enclosing_ball()) {
-                let swap = outer_is_b(a, b, &sa, &sb);
-                let (v, c, _, _) = if swap {
-                    boundary_unchecked::<T, SB, SA, (), CAP>(b, a, settings.order, &())?
-                } else {
-                    boundary_unchecked::<T, SA, SB, (), CAP>(a, b, settings.order, &())?
-                };
-                Ok(exact((v, c.saturating_add(p4))))
-            } else {
-                // Smooth pair: nothing to place into the rule, no occluder can cut it.
-                Ok(exact((exchange_unchecked(&sa, &sb, &())?, 2 * p4)))
-            }
-        }
+        Adjacency::Separate => separate(&mut pair, settings).map(exact),
+    }
+}
+
+/// A separate pair: the plain sum where the integrand is smooth, else the boundary path (with
+/// the outer patch split `OCCLUDED_OUTER_SPLIT`² where an occluder may cut: shadow edges
+/// crossing the inner patch make the outer integrand kink where they touch its edges).
+fn separate<T, SA, SB, O, const CAP: usize>(
+    pair: &mut PairContext<'_, '_, T, SA, SB, O, CAP>,
+    settings: PairSettings,
+) -> Result<(T, u64), PdmError>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
+    let order = settings.order;
+    let p4 = (order as u64).saturating_pow(4);
+    let occluders = pair.occluders;
+    if !settings.boundaries {
+        let (value, _) = pair.plain(order, occluders)?;
+        return Ok((value, p4));
+    }
+    if pair.may_occlude(order)? {
+        let outer_b = pair.occluded_outer_is_b();
+        pair.boundary(order, outer_b, OCCLUDED_OUTER_SPLIT, occluders)
+    } else if pair.straddles(order)? || pair.near() {
+        let outer_b = pair.outer_is_b(order)?;
+        let (value, count) = pair.boundary(order, outer_b, 1, &())?;
+        Ok((value, count.saturating_add(p4)))
+    } else {
+        // Smooth pair: nothing to place into the rule, no occluder can cut it.
+        let (value, _) = pair.plain(order, &())?;
+        Ok((value, 2 * p4))
     }
 }
