@@ -2,18 +2,19 @@
 //! pairs across visibility boundaries (four approximations, outer patch whole and split).
 
 use super::*;
+use crate::pair::SeparateRoute;
 
 /// The starting order of a separate pair from its geometry (module docs, item 2), capped at
-/// `max_order`, whether the pair straddles a visibility boundary at that order (or is closer
-/// than its size), and whether b should be the outer patch of the boundary path (unoccluded
-/// pairs, `pair::outer_is_b`; across occluders, `pair::occluded_outer_is_b`).
+/// `max_order`, and the pair's route judged at that order (`PairContext::separate_route`, the
+/// same decision as the fixed-order mode's: the plain sum, or the boundary path with its outer
+/// patch).
 #[inline(never)]
 pub(super) fn separate_plan<T, SA, SB, O, const CAP: usize>(
     a: &Patch<'_, T, SA>,
     b: &Patch<'_, T, SB>,
     settings: Adaptive<T>,
     occluders: &O,
-) -> Result<(usize, bool, bool), PdmError>
+) -> Result<(usize, SeparateRoute), PdmError>
 where
     T: Real,
     SA: Surface<T> + ?Sized,
@@ -34,17 +35,8 @@ where
         p += 1;
     }
     let p = p.min(settings.max_order);
-    pair.samples(p)?;
-    let (ball_a, ball_b) = pair.balls();
-    // Patches closer than their size: the plain rule's nodes do not resolve the kernel's peak,
-    // and two orders can agree by accident (a separate pair folded to 33° with the gap a
-    // quarter of its size: orders 10 and 12 agreed to 9e-7 with the value 4.4e-6 off). The
-    // boundary path refines the inner patch towards each close outer point, and its estimate
-    // compares the outer patch whole and split.
-    let occluded = occluders.may_block_between(&ball_a, &ball_b);
-    let across = occluded || crate::pair::near(&ball_a, &ball_b) || pair.straddles(p)?;
-    let swap = across && if occluded { pair.occluded_outer_is_b() } else { pair.outer_is_b(p)? };
-    Ok((p, across, swap))
+    let route = pair.separate_route(p)?;
+    Ok((p, route))
 }
 
 /// The plain PDM sum at `order` on both patches and its evaluations.
@@ -77,10 +69,10 @@ where
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
-    let (p, across, swap) = separate_plan::<T, SA, SB, O, CAP>(a, b, settings, occluders)?;
-    if across {
-        // A_a·F_{a→b} = A_b·F_{b→a}: the outer patch is the one the plan chose.
-        return if swap {
+    let (p, route) = separate_plan::<T, SA, SB, O, CAP>(a, b, settings, occluders)?;
+    if let SeparateRoute::Boundary { outer_b } | SeparateRoute::Occluded { outer_b } = route {
+        // A_a·F_{a→b} = A_b·F_{b→a}: the outer patch is the one the route chose.
+        return if outer_b {
             across_boundaries::<T, SB, SA, O, CAP>(b, a, settings, occluders, depth)
         } else {
             across_boundaries::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth)

@@ -4,6 +4,23 @@ use super::*;
 use crate::boundary::boundary_sum;
 use crate::samples::Ball;
 
+/// How a separate pair is integrated: decided once, by [`PairContext::separate_route`], for
+/// the fixed-order and the tolerance modes alike.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum SeparateRoute {
+    /// Nothing to place into the rule and no occluder can cut: the plain sum.
+    Plain,
+    /// The pair straddles a back-face cut (a kink in the integrand), or is closer than its
+    /// size (the plain rule's nodes do not resolve the kernel's peak, and two orders can agree
+    /// on a wrong value), and no occluder can cut: the boundary path, which places the cut into
+    /// the inner rule and refines the inner patch towards close outer points, with the outer
+    /// patch chosen by [`outer_is_b`] (`true`: b).
+    Boundary { outer_b: bool },
+    /// An occluder may cut a segment between the patches: the boundary path across the
+    /// occluders, the outer patch chosen by [`occluded_outer_is_b`].
+    Occluded { outer_b: bool },
+}
+
 /// One pair of patches as the dispatch and its methods see it, built once per pair: the two
 /// patches, the occluders, their enclosing balls (computed once, on first use) and the pair's
 /// two sample buffers. A buffer is filled at the order a method asks for, the first time it
@@ -129,6 +146,19 @@ where
         let (a, b) = (self.a, self.b);
         let (sa, sb) = self.samples(order)?;
         Ok(outer_is_b(a, b, sa, sb))
+    }
+
+    /// The route of a separate pair, judged on the samples at `order` (module docs of
+    /// [`crate::pair`]): occluded if an occluder may cut ([`PairContext::may_occlude`]), else the
+    /// boundary path if the pair straddles a back-face cut or is near, else the plain sum.
+    pub(crate) fn separate_route(&mut self, order: usize) -> Result<SeparateRoute, PdmError> {
+        if self.may_occlude(order)? {
+            Ok(SeparateRoute::Occluded { outer_b: self.occluded_outer_is_b() })
+        } else if self.straddles(order)? || self.near() {
+            Ok(SeparateRoute::Boundary { outer_b: self.outer_is_b(order)? })
+        } else {
+            Ok(SeparateRoute::Plain)
+        }
     }
 
     /// The plain PDM sum at `order` on both patches and its evaluations (`order`⁴).

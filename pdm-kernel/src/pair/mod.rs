@@ -320,16 +320,16 @@ where
         let (value, _) = pair.plain(order, occluders)?;
         return Ok((value, p4));
     }
-    if pair.may_occlude(order)? {
-        let outer_b = pair.occluded_outer_is_b();
-        pair.boundary(order, outer_b, OCCLUDED_OUTER_SPLIT, occluders)
-    } else if pair.straddles(order)? || pair.near() {
-        let outer_b = pair.outer_is_b(order)?;
-        let (value, count) = pair.boundary(order, outer_b, 1, &())?;
-        Ok((value, count.saturating_add(p4)))
-    } else {
+    match pair.separate_route(order)? {
+        SeparateRoute::Occluded { outer_b } => pair.boundary(order, outer_b, OCCLUDED_OUTER_SPLIT, occluders),
+        SeparateRoute::Boundary { outer_b } => {
+            let (value, count) = pair.boundary(order, outer_b, 1, &())?;
+            Ok((value, count.saturating_add(p4)))
+        }
         // Smooth pair: nothing to place into the rule, no occluder can cut it.
-        let (value, _) = pair.plain(order, &())?;
-        Ok((value, 2 * p4))
+        SeparateRoute::Plain => {
+            let (value, _) = pair.plain(order, &())?;
+            Ok((value, 2 * p4))
+        }
     }
 }
