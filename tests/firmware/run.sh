@@ -9,12 +9,14 @@
 # (cargo install, ≈270 s the first time). Needs no standard input.
 #
 # Budgets (see BUDGETS.md): flash of the kernel part with libm at order 5 ≤ FLASH_LIMIT bytes,
-# peak stack of one form-factor call (order 5, CAP 25) ≤ STACK_LIMIT bytes. PDM_BUDGETS=warn
-# reports an exceeded budget without failing (default: enforce).
+# peak stack of one form-factor call (order 5, CAP 25) ≤ STACK_LIMIT bytes, peak stack of
+# `pair_exchange` on the pair path (examples/pair_stack.rs, order 5, CAP 25) ≤ PAIR_STACK_LIMIT.
+# PDM_BUDGETS=warn reports an exceeded budget without failing (default: enforce).
 set -euo pipefail
 
 FLASH_LIMIT=16384
 STACK_LIMIT=4096
+PAIR_STACK_LIMIT=18432
 TARGET=thumbv7em-none-eabihf
 QEMU_TIMEOUT=120
 
@@ -143,6 +145,19 @@ else
     fail "build examples/minimal.rs"
 fi
 
+# The pair path's stack (examples/pair_stack.rs): pair_exchange on an occluded, a straddling and
+# a plain pair; the values are checked against the physical bounds there.
+step "build and run examples/pair_stack.rs (pair path stack)"
+status=0
+if cargo build --release --example pair_stack 2>&1 | tail -n 1; then
+    qemu "target/$TARGET/release/examples/pair_stack" >"$out/run-pair-stack.log" 2>&1 || status=$?
+    cat "$out/run-pair-stack.log"
+    [ "$status" -eq 0 ] || fail "pair_stack example exited with status $status"
+    [ "$(grep -c '^PAIR [a-z]* value=' "$out/run-pair-stack.log")" -eq 3 ] || fail "pair_stack: not 3 pairs within bounds"
+else
+    fail "build examples/pair_stack.rs"
+fi
+
 # ---- budgets -------------------------------------------------------------------------------
 step "budgets"
 text_rodata() { # elf -> bytes of .text + .rodata
@@ -179,8 +194,16 @@ for v in libm micromath; do
     echo "STACK peak of one form-factor call ($v, order 5, CAP 25): $s bytes (limit $STACK_LIMIT)"
     [ "$s" -le "$STACK_LIMIT" ] || over+=("stack ($v) $s > $STACK_LIMIT bytes")
 done
+pair_stack="$(sed -n 's/^PAIR_STACK_MAX \([0-9]*\)$/\1/p' "$out/run-pair-stack.log" 2>/dev/null || true)"
+if [ -z "$pair_stack" ]; then
+    fail "no PAIR_STACK_MAX from the pair_stack run"
+else
+    echo "STACK peak of pair_exchange on the pair path (libm, order 5, CAP 25): $pair_stack bytes (limit $PAIR_STACK_LIMIT)"
+    [ "$pair_stack" -le "$PAIR_STACK_LIMIT" ] || over+=("pair stack $pair_stack > $PAIR_STACK_LIMIT bytes")
+fi
 {
     echo "flash_kernel_libm=${flash_libm:-}"
+    echo "stack_pair_libm=${pair_stack:-}"
     echo "flash_kernel_micromath=${flash_mm:-}"
     echo "flash_kernel_libm_runtime_order=${flash_runtime_order:-}"
     echo "flash_kernel_libm_generic=${flash_generic:-}"

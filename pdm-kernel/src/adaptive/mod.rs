@@ -1,7 +1,9 @@
 //! Tolerance-driven integration: spend effort only where a pair of patches needs it.
 //!
 //! [`adaptive_exchange`] returns A_a·F_{a→b} with an error estimate, whether that estimate met
-//! the tolerance, and the number of integrand evaluations it took. Per pair it
+//! the tolerance, and the number of integrand evaluations it took. It takes the same route per
+//! pair as [`crate::pair_exchange`] (`pair/route.rs`, `PairContext::separate_route`: the
+//! decisions are made in one place) and differs in what it does on it. Per pair it
 //! 1. classifies the pair (`classify_near`): flat pairs that see each other wholly use the
 //!    contour form at two orders or more (where its terms cancel beyond the working precision,
 //!    the paths below take the pair if their rules resolve it, else the contour value stands
@@ -88,6 +90,7 @@
 use crate::error::PdmError;
 pub use crate::estimate::Estimate;
 use crate::integrand::mutually_facing;
+use crate::pair::{route, ContactSplits, Route};
 use crate::patch::Patch;
 use crate::real::Real;
 use crate::samples::PatchSamples;
@@ -286,23 +289,24 @@ where
             Some(result) => return result.map(|(estimate, _)| estimate),
         }
     }
-    if crate::singular::contact_reaches_collapsed_side(a, b, adjacency) {
-        return collapsed_contact::<T, SA, SB, O>(a, b, adjacency, gap, settings, occluders);
-    }
-    match adjacency {
-        Adjacency::SharedEdge { .. } | Adjacency::SharedVertex { .. } => {
-            // The transforms test occlusion only at their sample points: with an occluder that
-            // may cut the pair, successive orders can agree on a wrong value. Split both patches 2 × 2 until no occluder can cut a touching sub-pair;
-            // the separate sub-pairs take the boundary-aware path.
-            if depth < settings.max_depth && occluders.may_block_between(&a.enclosing_ball(), &b.enclosing_ball()) {
-                return split_both::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, 0);
-            }
+    let splits = ContactSplits { allowed: depth < settings.max_depth, collapsed: false };
+    match route(a, b, (adjacency, gap), occluders, splits) {
+        // The transforms test occlusion only at their nodes: with an occluder that may cut the
+        // pair, successive orders can agree on a wrong value.
+        Route::SplitContact => split_both::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, 0),
+        Route::Touching { adjacency, gap, collapsed: true } => {
+            collapsed_contact::<T, SA, SB, O>(a, b, adjacency, gap, settings, occluders)
+        }
+        Route::Identical { gap, collapsed: true } => {
+            collapsed_contact::<T, SA, SB, O>(a, b, Adjacency::Identical, gap, settings, occluders)
+        }
+        Route::Touching { adjacency, gap, collapsed: false } => {
             let eval = |p: usize| {
                 Ok((touching_unchecked(a, b, adjacency, gap, p, occluders)?, touching_evaluations(adjacency, p)))
             };
             by_order_doubling::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, eval, 4, Split::Both)
         }
-        Adjacency::Identical => identical::<T, SA, O, CAP>(a, settings, occluders, depth),
-        Adjacency::Separate => separate::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth),
+        Route::Identical { collapsed: false, .. } => identical::<T, SA, O, CAP>(a, settings, occluders, depth),
+        Route::Separate => separate::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth),
     }
 }

@@ -35,9 +35,14 @@
 //! Every value is checked against the physical bounds 0 ≤ A_a·F_{a→b} ≤ min(A_a, A_b) before
 //! it is returned.
 //!
-//! Files: the settings, the entry point and the dispatch here; `pieces.rs` (closed patches cut at
-//! their seams), `choose.rs` (near, resolved, which patch goes outside), `flat.rs` (the contour
-//! form's pairs).
+//! The decisions above are made once for this mode and the tolerance mode: `route.rs` (the
+//! route of a pair after the contour form) and `PairContext::separate_route` (a separate
+//! pair's). Each pair is integrated from one `PairContext` (`context.rs`): its two sample
+//! buffers are filled on first use and shared by every method, so b is sampled once per order.
+//!
+//! Files: the settings, the entry point and the dispatch here; `route.rs` (the route),
+//! `context.rs` (the pair context), `pieces.rs` (closed patches cut at their seams),
+//! `choose.rs` (near, resolved, which patch goes outside), `flat.rs` (the contour form's pairs).
 
 use crate::error::PdmError;
 use crate::estimate::Estimate;
@@ -56,11 +61,13 @@ mod context;
 #[cfg(feature = "closed-form")]
 mod flat;
 mod pieces;
+mod route;
 pub(crate) use choose::*;
 pub(crate) use context::*;
 #[cfg(feature = "closed-form")]
 pub(crate) use flat::*;
 pub(crate) use pieces::*;
+pub(crate) use route::*;
 
 /// Cells per side into which the outer patch of a pair that an occluder may cut is split.
 /// The inner integral is exponential in the order (closed-form boundaries), the outer one only
@@ -203,16 +210,16 @@ where
 #[doc(hidden)]
 pub const MAX_CONTACT_SPLITS: u32 = 4;
 
-/// One piece pair, with touching pairs that an occluder may cut split first: the touching
-/// transforms regularise the kernel at the contact, but a shadow crossing the pair puts a jump
-/// into the transformed integrand, and their rules then converge only algebraically (a box
-/// floor against a wall it shares an edge with, a sphere inside: 4e-4 at singular order 12).
-/// Both patches are split 2 × 2 and the 16 sub-pairs dispatched anew: the cells along the
-/// contact shrink until no occluder can cut between them (the transforms are then exact), and
-/// the others are separate pairs, which the boundary path integrates with the shadows placed
-/// into its inner rule. After `MAX_CONTACT_SPLITS` levels (an occluder that reaches the
-/// contact itself), the touching transforms take the remaining cells as they are.
-/// The recursion keeps no sample buffer in its own frame: [`dispatch`] holds them.
+/// One piece pair: its route ([`route`]), with a touching pair that an occluder may cut split
+/// first ([`Route::SplitContact`]: a shadow across the pair puts a jump into the transformed
+/// integrand, and the transforms' rules then converge only algebraically — a box floor against
+/// a wall it shares an edge with, a sphere inside: 4e-4 at singular order 12). Both patches are
+/// split 2 × 2 and the 16 sub-pairs routed anew: the cells along the contact shrink until no
+/// occluder can cut between them, and the others are separate pairs, which the boundary path
+/// integrates with the shadows placed into its inner rule. After `MAX_CONTACT_SPLITS` levels
+/// (an occluder that reaches the contact itself), the touching transforms take the remaining
+/// cells as they are. The recursion keeps no sample buffer in its own frame: [`dispatch`]
+/// holds them.
 fn split_occluded_contacts<T, SA, SB, O, const CAP: usize>(
     a: &Patch<'_, T, SA>,
     b: &Patch<'_, T, SB>,
@@ -226,48 +233,44 @@ where
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
-    let (adjacency, gap) = classify_near(a, b);
-    let touching = matches!(adjacency, Adjacency::SharedEdge { .. } | Adjacency::SharedVertex { .. });
-    if settings.boundaries
-        && touching
-        && depth < MAX_CONTACT_SPLITS
-        && occluders.may_block_between(&a.enclosing_ball(), &b.enclosing_ball())
-    {
-        let (mut value, mut count, mut rounding) = (T::ZERO, 0u64, T::ZERO);
-        let (ra, rb) = (a.rect(), b.rect());
-        for i in 0..4 {
-            let pa = Patch::new(a.surface(), ra.cell(i / 2, i % 2, 2, 2))?;
-            for j in 0..4 {
-                let pb = Patch::new(b.surface(), rb.cell(j / 2, j % 2, 2, 2))?;
-                let (v, c, r) = split_occluded_contacts::<T, SA, SB, O, CAP>(&pa, &pb, settings, occluders, depth + 1)?;
-                value += v;
-                count = count.saturating_add(c);
-                rounding += r;
-            }
-        }
-        return Ok((value, count, rounding));
+    if let Some(done) = dispatch::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth)? {
+        return Ok(done);
     }
-    dispatch::<T, SA, SB, O, CAP>(a, b, (adjacency, gap), settings, occluders)
+    let (mut value, mut count, mut rounding) = (T::ZERO, 0u64, T::ZERO);
+    let (ra, rb) = (a.rect(), b.rect());
+    for i in 0..4 {
+        let pa = Patch::new(a.surface(), ra.cell(i / 2, i % 2, 2, 2))?;
+        for j in 0..4 {
+            let pb = Patch::new(b.surface(), rb.cell(j / 2, j % 2, 2, 2))?;
+            let (v, c, r) = split_occluded_contacts::<T, SA, SB, O, CAP>(&pa, &pb, settings, occluders, depth + 1)?;
+            value += v;
+            count = count.saturating_add(c);
+            rounding += r;
+        }
+    }
+    Ok((value, count, rounding))
 }
 
-/// One piece pair by the method it needs, given its classification (`classify_near`):
-/// (value, evaluations, bound on the contour form's rounding — zero for the other methods).
-/// The pair's context (its two sample buffers) lives in this frame, which the recursion above
-/// does not keep while it descends.
+/// One piece pair by the method it needs: the contour form where it applies, else by its
+/// [`route`]: (value, evaluations, bound on the contour form's rounding — zero for the other
+/// methods), or `None` for a pair to be split ([`Route::SplitContact`]). The pair's context
+/// (its two sample buffers) lives in this frame, which returns before the recursion above
+/// descends.
 #[inline(never)]
 fn dispatch<T, SA, SB, O, const CAP: usize>(
     a: &Patch<'_, T, SA>,
     b: &Patch<'_, T, SB>,
-    (adjacency, gap): (Adjacency, T),
     settings: PairSettings,
     occluders: &O,
-) -> Result<(T, u64, T), PdmError>
+    depth: u32,
+) -> Result<Option<(T, u64, T)>, PdmError>
 where
     T: Real,
     SA: Surface<T> + ?Sized,
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
+    let (adjacency, gap) = classify_near(a, b);
     let mut pair = PairContext::<T, SA, SB, O, CAP>::new(a, b, occluders);
     #[cfg(feature = "closed-form")]
     if settings.boundaries && contour_applies(adjacency) {
@@ -285,18 +288,22 @@ where
                 if adjacency == Adjacency::Separate
                     && crate::bounds::cancels(v, r)
                     && pair.resolved(settings.order)? => {}
-            Some(result) => return result,
+            Some(result) => return result.map(Some),
             None => {}
         }
     }
-    let exact = |(v, c): (T, u64)| (v, c, T::ZERO);
-    match adjacency {
-        Adjacency::SharedEdge { .. } | Adjacency::SharedVertex { .. } => {
+    let splits = ContactSplits { allowed: settings.boundaries && depth < MAX_CONTACT_SPLITS, collapsed: true };
+    let exact = |(v, c): (T, u64)| Some((v, c, T::ZERO));
+    match route(a, b, (adjacency, gap), occluders, splits) {
+        Route::SplitContact => Ok(None),
+        Route::Touching { adjacency, gap, .. } => {
             let count = crate::singular::touching_evaluations(adjacency, settings.singular_order);
             Ok(exact((touching_unchecked(a, b, adjacency, gap, settings.singular_order, occluders)?, count)))
         }
-        Adjacency::Identical => crate::singular::identical_unchecked(a, settings.singular_order, occluders).map(exact),
-        Adjacency::Separate => separate(&mut pair, settings).map(exact),
+        Route::Identical { .. } => {
+            crate::singular::identical_unchecked(a, settings.singular_order, occluders).map(exact)
+        }
+        Route::Separate => separate(&mut pair, settings).map(exact),
     }
 }
 

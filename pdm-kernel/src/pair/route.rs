@@ -1,0 +1,73 @@
+//! The route of a pair: which method it needs, decided once for the fixed-order mode
+//! ([`pair_exchange`]) and the tolerance mode ([`crate::adaptive_exchange`]).
+//!
+//! Both modes first try the contour form on two flat patches that see each other wholly
+//! ([`flat_pair`]: no occluder can cut between them), each with its own rule for a contour value
+//! whose terms cancel. Every other pair takes the route [`route`] gives; a separate pair's
+//! route is refined by [`PairContext::separate_route`] on its samples. The modes differ only in
+//! what they do on a route: the fixed-order mode evaluates it once at the orders it was given,
+//! the tolerance mode compares orders and splits cells until its estimate meets the tolerance.
+
+use super::*;
+
+/// Which method a pair needs (after the contour form; module docs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Route<T> {
+    /// A touching pair that an occluder may cut: split both patches 2 × 2 and route the 16
+    /// sub-pairs. The transforms test visibility only at their nodes, so a shadow across the
+    /// pair puts a jump into the transformed integrand and their rules converge only
+    /// algebraically; the cells along the contact shrink until no occluder can cut them, and
+    /// the other sub-pairs are separate pairs, whose shadows the boundary path places.
+    SplitContact,
+    /// A shared edge or vertex: the regularising transforms (`singular/`). `collapsed`: the
+    /// contact reaches a side collapsed to a point (a cone's apex), where they converge only
+    /// algebraically.
+    Touching { adjacency: Adjacency, gap: T, collapsed: bool },
+    /// The same patch twice: the identical-panel transform (`collapsed` as above).
+    Identical { gap: T, collapsed: bool },
+    /// Separate patches: [`PairContext::separate_route`] decides on the samples.
+    Separate,
+}
+
+/// When a touching pair that an occluder may cut is split ([`Route::SplitContact`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct ContactSplits {
+    /// The caller may split this pair further (its depth limit is not reached).
+    pub(crate) allowed: bool,
+    /// Also split where the contact reaches a collapsed side. The fixed-order mode does (its
+    /// splits are capped at `MAX_CONTACT_SPLITS`, and the cells away from the collapsed point
+    /// become exact); the tolerance mode does not (its estimate would split the cells at the
+    /// collapsed point, algebraic at every level, down to `max_depth`).
+    pub(crate) collapsed: bool,
+}
+
+/// The route of the pair (a, b) whose contact `classify_near` found (module docs).
+pub(crate) fn route<T, SA, SB, O>(
+    a: &Patch<'_, T, SA>,
+    b: &Patch<'_, T, SB>,
+    (adjacency, gap): (Adjacency, T),
+    occluders: &O,
+    splits: ContactSplits,
+) -> Route<T>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
+    let collapsed = crate::singular::contact_reaches_collapsed_side(a, b, adjacency);
+    match adjacency {
+        Adjacency::SharedEdge { .. } | Adjacency::SharedVertex { .. } => {
+            if splits.allowed
+                && (splits.collapsed || !collapsed)
+                && occluders.may_block_between(&a.enclosing_ball(), &b.enclosing_ball())
+            {
+                Route::SplitContact
+            } else {
+                Route::Touching { adjacency, gap, collapsed }
+            }
+        }
+        Adjacency::Identical => Route::Identical { gap, collapsed },
+        Adjacency::Separate => Route::Separate,
+    }
+}
