@@ -1,4 +1,4 @@
-//! Generator for the Gauss–Legendre tables of the `no_std` kernel (`pdm-kernel/src/gauss/tables.rs`).
+//! Generator for the Gauss–Legendre tables of the `no_std` kernel (`pdm-kernel/src/gauss_tables.rs`).
 //!
 //! Run `cargo run -p pdm-host --bin gen-gauss-tables` to rewrite the table file, or with `--check`
 //! to compare; the test `gauss_tables_are_bit_exact` in `pdm-host/tests/gauss_tables.rs` fails if the
@@ -399,7 +399,7 @@ struct Width {
     weights: Vec<u64>,
 }
 
-/// The complete text of `pdm-kernel/src/gauss/tables.rs` for the given tables.
+/// The complete text of `pdm-kernel/src/gauss_tables.rs` for the given tables.
 ///
 /// Layout: one `static` per order, width and kind (`NODES_5_F32: [f32; 5]`, `WEIGHTS_5_F32`, …), so
 /// that a build which names its order at compile time (`fixed_f32::<5>()`, used by the kernel's
@@ -480,7 +480,7 @@ pub fn render(t: &Tables) -> String {
     s
 }
 
-/// Generates and renders the complete text of `pdm-kernel/src/gauss/tables.rs`.
+/// Generates and renders the complete text of `pdm-kernel/src/gauss_tables.rs`.
 ///
 /// # Errors
 /// See [`tables`].
@@ -496,8 +496,7 @@ pub fn tables_path() -> PathBuf {
         .map_or_else(|| host.join(".."), Path::to_path_buf)
         .join("pdm-kernel")
         .join("src")
-        .join("gauss")
-        .join("tables.rs")
+        .join("gauss_tables.rs")
 }
 
 /// The first line where `committed` and `generated` differ: (1-based line number, committed line,

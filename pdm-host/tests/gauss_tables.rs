@@ -1,4 +1,4 @@
-//! The kernel's Gauss–Legendre tables (`pdm-kernel/src/gauss/tables.rs`) against their generator
+//! The kernel's Gauss–Legendre tables (`pdm-kernel/src/gauss_tables.rs`) against their generator
 //! `pdm_host::gauss_gen`: the committed file must be byte-identical to the generator's output, the
 //! multi-precision reference must itself be right, and every f64/f32 entry must be the correctly
 //! rounded reference value.
@@ -18,7 +18,7 @@ fn below_ten_to_minus(raw: &IBig, bits: usize, digits: u32) -> bool {
 
 #[test]
 fn gauss_tables_are_bit_exact() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("pdm-kernel/src/gauss/tables.rs");
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("pdm-kernel/src/gauss_tables.rs");
     let committed = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
     let generated = gauss_gen::render_tables().expect("table generation failed");
     if let Some((line, old, new)) = gauss_gen::first_difference(&committed, &generated) {

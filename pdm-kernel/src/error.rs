@@ -56,7 +56,11 @@ impl fmt::Display for PdmError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Self::UnsupportedOrder { order } => {
-                write!(f, "unsupported Gauss-Legendre order {order} (supported: 1..={})", crate::gauss::MAX_ORDER)
+                write!(
+                    f,
+                    "unsupported Gauss-Legendre order {order} (supported: 1..={})",
+                    crate::gauss_tables::MAX_ORDER
+                )
             }
             Self::NonFinite => f.write_str("non-finite (NaN or infinite) input or intermediate value"),
             Self::EmptyParameterRange => f.write_str("empty parameter range (start >= end)"),

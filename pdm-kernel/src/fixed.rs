@@ -29,11 +29,11 @@
 //! [`MAX_ORDER`]: crate::gauss::MAX_ORDER
 
 use crate::error::PdmError;
-use crate::form_factor::{exchange, form_factor};
 use crate::gauss::GaussRule;
 use crate::patch::{Patch, PatchGrid};
 use crate::real::Real;
 use crate::samples::PatchSamples;
+use crate::sum::{exchange, form_factor};
 use crate::surface::Surface;
 use crate::visibility::Occluder;
 
@@ -184,7 +184,8 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::form_factor::{form_factor_between, surface_form_factor, Quadrature};
+    use crate::form_factor::{form_factor_between, Quadrature};
+    use crate::substructure::surface_form_factor;
     use crate::surface::{Parallelogram, Sphere};
     use crate::vec3::vec3;
 

@@ -125,6 +125,48 @@ pub struct PatchGrid<'s, T, S: ?Sized> {
     next: usize,
 }
 
+/// Segments of the polylines that measure a side.
+const SIDE_SEGMENTS: usize = 12;
+
+/// Arc lengths of a patch's image along t and along s: the longest of the polylines (12
+/// segments) along the two edges and the mid-line in each direction. A chord would be zero on a
+/// side that closes on itself (the θ side of a whole disk, cylinder or sphere band).
+pub(crate) fn side_lengths<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>) -> (T, T) {
+    let r = p.rect();
+    let g = p.surface();
+    let n = T::from_usize(SIDE_SEGMENTS);
+    let polyline = |point: &dyn Fn(T) -> crate::vec3::Vec3<T>| {
+        let mut length = T::ZERO;
+        let mut prev = point(T::ZERO);
+        for k in 1..=SIDE_SEGMENTS {
+            let next = point(T::from_usize(k) / n);
+            length += (next - prev).norm();
+            prev = next;
+        }
+        length
+    };
+    let (mut along_t, mut along_s) = (T::ZERO, T::ZERO);
+    for f in [T::ZERO, T::HALF, T::ONE] {
+        let s = r.s0 + (r.s1 - r.s0) * f;
+        let t = r.t0 + (r.t1 - r.t0) * f;
+        along_t = along_t.max(polyline(&|x| g.point(r.t0 + (r.t1 - r.t0) * x, s)));
+        along_s = along_s.max(polyline(&|x| g.point(t, r.s0 + (r.s1 - r.s0) * x)));
+    }
+    (along_t, along_s)
+}
+
+/// Half `k` (0 or 1) of a patch with side lengths `(along_t, along_s)`, split across the
+/// longer one.
+pub(crate) fn half_patch<'s, T: Real, S: Surface<T> + ?Sized>(
+    p: &Patch<'s, T, S>,
+    (along_t, along_s): (T, T),
+    k: usize,
+) -> Option<Patch<'s, T, S>> {
+    let r: ParamRect<T> = p.rect();
+    let cell = if along_t >= along_s { r.cell(k, 0, 2, 1) } else { r.cell(0, k, 1, 2) };
+    Patch::new(p.surface(), cell).ok()
+}
+
 impl<T: Copy, S: ?Sized> Clone for PatchGrid<'_, T, S> {
     fn clone(&self) -> Self {
         Self { surface: self.surface, rect: self.rect, m: self.m, n: self.n, next: self.next }

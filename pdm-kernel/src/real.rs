@@ -169,10 +169,23 @@ macro_rules! impl_real {
             }
             #[inline]
             fn gauss_table(order: usize) -> Option<(&'static [Self], &'static [Self])> {
-                crate::gauss::rule_slices(&crate::gauss::tables::$nodes, &crate::gauss::tables::$weights, order)
+                rule_slices(&crate::gauss_tables::$nodes, &crate::gauss_tables::$weights, order)
             }
         }
     };
+}
+
+/// Order `order`'s nodes and weights out of the generated per-order index (`NODES_F32`, …:
+/// entry n is order n's table); `None` outside `1..=MAX_ORDER`.
+fn rule_slices<T>(
+    nodes: &'static [&'static [T]],
+    weights: &'static [&'static [T]],
+    order: usize,
+) -> Option<(&'static [T], &'static [T])> {
+    if order == 0 || order > crate::gauss_tables::MAX_ORDER {
+        return None;
+    }
+    Some((*nodes.get(order)?, *weights.get(order)?))
 }
 
 impl_real!(f32, NODES_F32, WEIGHTS_F32, 1.0e-5, f32m);

@@ -280,3 +280,40 @@ pub fn with_capacity<J: WithCapacity>(needed: usize, job: J) -> Result<J::Output
 pub fn capacity_for(needed: usize) -> Option<usize> {
     CAPACITIES.into_iter().find(|&c| c >= needed)
 }
+
+/// F_{A→B} between the patches of grid `a` and grid `b` by substructuring
+/// ([`crate::surface_exchange`] with [`crate::Method::Plain`]): each patch pair as by
+/// [`crate::form_factor_between`] (the PDM sum, or [`crate::pair_exchange`] on the pairs the sum cannot
+/// resolve: adjacent and identical patches, patches closer than [`crate::form_factor::RESOLVED_DISTANCE`]
+/// spacings), divided by A_A, the sum of the patch areas by eq. (12) with the same rule's
+/// weights (so that a surface's factors to a closed enclosure sum to 1 up to the quadrature
+/// error). Every patch is re-sampled for each pair; nothing is allocated.
+///
+/// ```
+/// use pdm_kernel::{surface_form_factor, vec3, Parallelogram, PatchGrid, Quadrature};
+/// // Perpendicular unit squares sharing an edge (C-14: 0.2000437760754...), each cut 2 × 2:
+/// // the pairs along the shared edge go to the shared-edge transform, the others to the sum.
+/// let floor = Parallelogram::new(vec3(0.0, 0.0, 0.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0))?;
+/// let wall = Parallelogram::new(vec3(0.0, 0.0, 0.0), vec3(0.0, 0.0, 1.0), vec3(1.0, 0.0, 0.0))?;
+/// let (a, b) = (PatchGrid::new(&floor, 2, 2)?, PatchGrid::new(&wall, 2, 2)?);
+/// let f = surface_form_factor::<f64, _, _, _, 256>(a, b, Quadrature::uniform(12), &())?;
+/// assert!((f - 0.20004377607540316).abs() < 1e-9);
+/// # Ok::<(), pdm_kernel::PdmError>(())
+/// ```
+pub fn surface_form_factor<T, SA, SB, O, const CAP: usize>(
+    a: PatchGrid<'_, T, SA>,
+    b: PatchGrid<'_, T, SB>,
+    quadrature: Quadrature,
+    occluders: &O,
+) -> Result<T, PdmError>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
+    let rule_a = GaussRule::<T>::new(quadrature.order_a)?;
+    let rule_b = GaussRule::<T>::new(quadrature.order_b)?;
+    let (total, area) = plain_total::<T, SA, SB, O, CAP>(a, b, &rule_a, &rule_b, occluders)?;
+    crate::bounds::form_factor(total.value / area)
+}

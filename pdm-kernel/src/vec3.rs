@@ -55,7 +55,7 @@ where
     }
 }
 
-impl<T: crate::Real> Vec3<T> {
+impl<T: crate::real::Real> Vec3<T> {
     /// The zero vector.
     pub const ZERO: Self = Vec3 { x: T::ZERO, y: T::ZERO, z: T::ZERO };
 
@@ -89,7 +89,7 @@ impl<T: crate::Real> Vec3<T> {
     /// Converts between widths (through f64).
     #[inline]
     #[must_use]
-    pub fn cast<U: crate::Real>(self) -> Vec3<U> {
+    pub fn cast<U: crate::real::Real>(self) -> Vec3<U> {
         Vec3 { x: U::from_f64(self.x.to_f64()), y: U::from_f64(self.y.to_f64()), z: U::from_f64(self.z.to_f64()) }
     }
 }

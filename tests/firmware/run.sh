@@ -184,7 +184,7 @@ if [ -f "$out/firmware-libm.elf" ] && [ -f "$out/firmware-baseline.elf" ] && [ -
 fi
 # The compile-time order links order 5's Gauss table only (2 × 20 B), not the tables of every order.
 if [ -f "$out/firmware-libm.elf" ]; then
-    tables="$("$llvm_bin/llvm-nm" -C "$out/firmware-libm.elf" | sed -n 's/.*gauss::tables::\([A-Z0-9_]*\).*/\1/p' | sort | tr '\n' ' ')"
+    tables="$("$llvm_bin/llvm-nm" -C "$out/firmware-libm.elf" | sed -n 's/.*gauss_tables::\([A-Z0-9_]*\).*/\1/p' | sort | tr '\n' ' ')"
     echo "Gauss tables linked (libm build): $tables"
     [ "$tables" = "NODES_5_F32 WEIGHTS_5_F32 " ] || fail "the firmware links Gauss tables other than order 5's: $tables"
 fi

@@ -1,4 +1,4 @@
-//! Regenerates `pdm-kernel/src/gauss/tables.rs` (the kernel's Gauss–Legendre tables) from the
+//! Regenerates `pdm-kernel/src/gauss_tables.rs` (the kernel's Gauss–Legendre tables) from the
 //! multi-precision reference in `pdm_host::gauss_gen`.
 //!
 //! `cargo run -p pdm-host --bin gen-gauss-tables` writes the file; with `--check` it only compares
@@ -9,7 +9,7 @@ use std::process::ExitCode;
 use pdm_host::gauss_gen;
 
 const USAGE: &str = "usage: gen-gauss-tables [--check]\n  \
-    (no argument)  write pdm-kernel/src/gauss/tables.rs\n  \
+    (no argument)  write pdm-kernel/src/gauss_tables.rs\n  \
     --check        compare with the committed file; exit 1 on any difference";
 
 fn main() -> ExitCode {

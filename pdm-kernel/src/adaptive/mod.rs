@@ -89,13 +89,11 @@
 
 use crate::error::PdmError;
 pub use crate::estimate::Estimate;
-use crate::integrand::mutually_facing;
 use crate::pair::{route, ContactSplits, Route};
 use crate::patch::Patch;
 use crate::real::Real;
-use crate::samples::PatchSamples;
 use crate::singular::{classify_near, touching_evaluations, touching_unchecked, Adjacency};
-use crate::surface::{ParamRect, Surface};
+use crate::surface::Surface;
 use crate::visibility::Occluder;
 
 mod leaves;
@@ -103,7 +101,7 @@ mod separate;
 mod split;
 use leaves::*;
 use separate::*;
-pub(crate) use split::*;
+use split::*;
 
 /// Largest accepted `max_depth`: at most 2^24 halvings deep. The recursion keeps no sample
 /// buffer on the stack: they live in non-inlined frames that return before it recurses.

@@ -1,7 +1,8 @@
 //! Splitting a pair that has not met its tolerance: halving by arc length, both patches 2 × 2
-//! for touching pairs, and the straddle test.
+//! for touching pairs.
 
 use super::*;
+use crate::patch::{half_patch, side_lengths};
 
 /// The children of a subdivision, or — where the working precision cannot carry it out (cells
 /// below the geometry's resolution: `Err(Degenerate)` or `Err(Unresolvable)` from a child) —
@@ -73,66 +74,4 @@ where
         total.add(e);
     }
     Ok(total)
-}
-
-/// Segments of the polylines that measure a side.
-pub(super) const SIDE_SEGMENTS: usize = 12;
-
-/// Arc lengths of a patch's image along t and along s: the longest of the polylines (12
-/// segments) along the two edges and the mid-line in each direction. A chord would be zero on a
-/// side that closes on itself (the θ side of a whole disk, cylinder or sphere band).
-pub(crate) fn side_lengths<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>) -> (T, T) {
-    let r = p.rect();
-    let g = p.surface();
-    let n = T::from_usize(SIDE_SEGMENTS);
-    let polyline = |point: &dyn Fn(T) -> crate::vec3::Vec3<T>| {
-        let mut length = T::ZERO;
-        let mut prev = point(T::ZERO);
-        for k in 1..=SIDE_SEGMENTS {
-            let next = point(T::from_usize(k) / n);
-            length += (next - prev).norm();
-            prev = next;
-        }
-        length
-    };
-    let (mut along_t, mut along_s) = (T::ZERO, T::ZERO);
-    for f in [T::ZERO, T::HALF, T::ONE] {
-        let s = r.s0 + (r.s1 - r.s0) * f;
-        let t = r.t0 + (r.t1 - r.t0) * f;
-        along_t = along_t.max(polyline(&|x| g.point(r.t0 + (r.t1 - r.t0) * x, s)));
-        along_s = along_s.max(polyline(&|x| g.point(t, r.s0 + (r.s1 - r.s0) * x)));
-    }
-    (along_t, along_s)
-}
-
-/// Half `k` (0 or 1) of a patch with side lengths `(along_t, along_s)`, split across the
-/// longer one.
-pub(crate) fn half_patch<'s, T: Real, S: Surface<T> + ?Sized>(
-    p: &Patch<'s, T, S>,
-    (along_t, along_s): (T, T),
-    k: usize,
-) -> Option<Patch<'s, T, S>> {
-    let r: ParamRect<T> = p.rect();
-    let cell = if along_t >= along_s { r.cell(k, 0, 2, 1) } else { r.cell(0, k, 1, 2) };
-    Patch::new(p.surface(), cell).ok()
-}
-
-/// `true` if some sample pairs pass the two-sided curvature test and others do not.
-pub(crate) fn straddles_curvature_cut<T: Real, const CA: usize, const CB: usize>(
-    a: &PatchSamples<T, CA>,
-    b: &PatchSamples<T, CB>,
-) -> bool {
-    let mut seen_visible = false;
-    let mut seen_hidden = false;
-    for sa in a.iter() {
-        for sb in b.iter() {
-            let visible = mutually_facing(sa.point, sa.unit_normal, sb.point, sb.unit_normal);
-            seen_visible |= visible;
-            seen_hidden |= !visible;
-            if seen_visible && seen_hidden {
-                return true;
-            }
-        }
-    }
-    false
 }

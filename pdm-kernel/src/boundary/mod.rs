@@ -264,9 +264,9 @@ where
         // Halved across its longer side by arc length; a half below the coordinates'
         // resolution ends the grading.
         let cell = Patch::new(g, r)?;
-        let lengths = crate::adaptive::side_lengths(&cell);
+        let lengths = crate::patch::side_lengths(&cell);
         let (Some(lo), Some(hi)) =
-            (crate::adaptive::half_patch(&cell, lengths, 0), crate::adaptive::half_patch(&cell, lengths, 1))
+            (crate::patch::half_patch(&cell, lengths, 0), crate::patch::half_patch(&cell, lengths, 1))
         else {
             break;
         };

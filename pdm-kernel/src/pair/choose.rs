@@ -11,7 +11,7 @@ pub(crate) fn near<T: Real>(a: &crate::samples::Ball<T>, b: &crate::samples::Bal
 }
 
 /// Whether the Gauss rules of order `order` resolve the pair
-/// ([`crate::form_factor::samples_resolved`]), for a caller without a pair context (the
+/// ([`crate::sum::samples_resolved`]), for a caller without a pair context (the
 /// tolerance mode's recursion, which keeps no sample buffer in its own frames).
 #[cfg(feature = "closed-form")]
 #[inline(never)]
@@ -184,4 +184,24 @@ pub(super) fn is_flat<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>) -> b
     let Some(centre) = at(T::HALF, T::HALF) else { return false };
     let limit = T::ONE - T::from_f64(64.0) * T::EPSILON;
     [(lo, lo), (hi, lo), (lo, hi), (hi, hi)].iter().all(|&(x, y)| at(x, y).is_some_and(|n| n.dot(centre) >= limit))
+}
+
+/// `true` if some sample pairs pass the two-sided curvature test and others do not.
+pub(crate) fn straddles_curvature_cut<T: Real, const CA: usize, const CB: usize>(
+    a: &PatchSamples<T, CA>,
+    b: &PatchSamples<T, CB>,
+) -> bool {
+    let mut seen_visible = false;
+    let mut seen_hidden = false;
+    for sa in a.iter() {
+        for sb in b.iter() {
+            let visible = mutually_facing(sa.point, sa.unit_normal, sb.point, sb.unit_normal);
+            seen_visible |= visible;
+            seen_hidden |= !visible;
+            if seen_visible && seen_hidden {
+                return true;
+            }
+        }
+    }
+    false
 }

@@ -113,18 +113,18 @@ where
     }
 
     /// Whether the Gauss rules of order `order` resolve the pair
-    /// ([`crate::form_factor::samples_resolved`]).
+    /// ([`crate::sum::samples_resolved`]).
     #[cfg(feature = "closed-form")]
     pub(crate) fn resolved(&mut self, order: usize) -> Result<bool, PdmError> {
         let (sa, sb) = self.samples(order)?;
-        Ok(crate::form_factor::samples_resolved(sa, order, sb, order))
+        Ok(crate::sum::samples_resolved(sa, order, sb, order))
     }
 
     /// Whether some sample pairs at `order` face each other and some do not (the pair straddles
-    /// a back-face cut: `adaptive::straddles_curvature_cut`).
+    /// a back-face cut: [`straddles_curvature_cut`]).
     pub(crate) fn straddles(&mut self, order: usize) -> Result<bool, PdmError> {
         let (sa, sb) = self.samples(order)?;
-        Ok(crate::adaptive::straddles_curvature_cut(sa, sb))
+        Ok(straddles_curvature_cut(sa, sb))
     }
 
     /// Whether the patches are closer than the larger one's radius ([`near`]).
@@ -165,7 +165,7 @@ where
     pub(crate) fn plain<P: Occluder<T> + ?Sized>(&mut self, order: usize, occluders: &P) -> Result<(T, u64), PdmError> {
         let (sa, sb) = self.samples(order)?;
         let evaluations = (sa.len() as u64).saturating_mul(sb.len() as u64);
-        Ok((crate::form_factor::exchange_unchecked(sa, sb, occluders)?, evaluations))
+        Ok((crate::sum::exchange_unchecked(sa, sb, occluders)?, evaluations))
     }
 
     /// A_a·F_{a→b} by the boundary path (`boundary/`) at `order`, the outer patch (b if

@@ -3,7 +3,7 @@
 //! **Curvature test.** A pair of sample points (P_a, P_b) can exchange energy only if each lies in
 //! front of the other's tangent plane: n_a·e_ab > 0 **and** n_b·e_ba > 0 (section 3.2: both dot
 //! products, which is also correct for the plane–curved case of section 3.1 and for concave
-//! surfaces, section 3.3). [`mutually_facing`] is that test; the PDM sum applies it to every pair.
+//! surfaces, section 3.3). [`crate::mutually_facing`] is that test; the PDM sum applies it to every pair.
 //!
 //! **Occlusion.** An [`Occluder`] answers whether the open segment P_a → P_b crosses it. The
 //! built-in shapes are exact occluders (closed-form segment intersection): [`Sphere`],
@@ -31,8 +31,6 @@ use crate::real::Real;
 use crate::samples::Ball;
 use crate::surface::{Cylinder, Disk, Parallelogram, Sphere};
 use crate::vec3::Vec3;
-
-pub use crate::integrand::mutually_facing;
 
 mod bezier;
 mod combine;

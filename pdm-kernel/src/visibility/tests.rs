@@ -1,6 +1,7 @@
 //! Unit tests of the curvature test and the occluders.
 
 use super::*;
+use crate::integrand::mutually_facing;
 use crate::surface::Side;
 use crate::vec3::vec3;
 
