@@ -63,6 +63,9 @@ impl<T: Real> Surface<T> for Shape<T> {
     fn straight_corners(&self, rect: ParamRect<T>) -> Option<[Vec3<T>; 4]> {
         each!(self, g => g.straight_corners(rect))
     }
+    fn facing_along_t(&self, s: T, p: Vec3<T>, np: Vec3<T>) -> Option<[[T; 3]; 2]> {
+        each!(self, g => g.facing_along_t(s, p, np))
+    }
 }
 
 /// A plane n̂·(x − o) = 0 with unit normal n̂ (f64).

@@ -12,6 +12,10 @@ pub(super) struct Inner<'x, T: Real, SB: Surface<T> + ?Sized, O: ?Sized> {
     pub(super) probes: usize,
     /// b's affine map when visibility is handled in closed form.
     pub(super) affine: Option<(Vec3<T>, Vec3<T>, Vec3<T>)>,
+    /// b's t-lines have trigonometric facing tests ([`Surface::facing_along_t`]) and no
+    /// occluder can cut: visibility along them in closed form.
+    #[cfg(feature = "closed-form")]
+    pub(super) trigonometric: bool,
     /// b's outline when b is flat but not a parallelogram (a disk or annulus sector, a planar
     /// Bézier patch): the point-to-region form along it.
     #[cfg(feature = "closed-form")]
@@ -108,6 +112,20 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
             if self.line_polys(p, np, s, polys) && closed_form_line(polys.used(), r.t0, r.t1, &vis_at, candidates, line)
             {
                 return Ok(());
+            }
+        }
+        #[cfg(feature = "closed-form")]
+        if self.trigonometric {
+            if let Some(fs) = self.surface.facing_along_t(s, p, np) {
+                let mut fresh = None;
+                let mut borrowed = self.scratch.try_borrow_mut();
+                let scratch: &mut LineScratch<T> = match borrowed.as_deref_mut() {
+                    Ok(scratch) => scratch,
+                    Err(_) => fresh.insert(LineScratch::new()),
+                };
+                if trigonometric_line(&fs, r.t0, r.t1, &vis_at, &mut scratch.candidates, line) {
+                    return Ok(());
+                }
             }
         }
         // Bracket visibility changes along the line, refine each by bisection.

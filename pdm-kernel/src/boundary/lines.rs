@@ -186,10 +186,20 @@ pub(super) fn closed_form_line<T: Real>(
             }
         });
     }
-    if overflow {
-        return false;
-    }
-    let used = candidates.get_mut(..n).unwrap_or_default();
+    !overflow && line_from_candidates(candidates.get_mut(..n).unwrap_or_default(), t0, t1, vis_at, line)
+}
+
+/// The visibility structure of the line t ∈ [t0, t1] from the candidate switches `used` (inside
+/// (t0, t1), each with the id of the function whose root it is): each piece between consecutive
+/// candidates is classified by the exact test at its midpoint, and equal neighbours merged.
+/// `false` if the line's buffer is too small.
+pub(super) fn line_from_candidates<T: Real>(
+    used: &mut [(T, u64)],
+    t0: T,
+    t1: T,
+    vis_at: &impl Fn(T) -> bool,
+    line: &mut Line<T>,
+) -> bool {
     sort_by_position(used);
     line.n = 0;
     line.ids = 0;
@@ -233,6 +243,86 @@ pub(super) fn closed_form_line<T: Real>(
         }
     }
     push(&mut line.breaks, &mut line.n, t1).is_ok()
+}
+
+/// The visibility structure of the line t ∈ [t0, t1] whose visibility changes are among the
+/// roots of the first-degree trigonometric polynomials `fs` ([`Surface::facing_along_t`]);
+/// `false` if there are too many candidates.
+#[cfg(feature = "closed-form")]
+pub(super) fn trigonometric_line<T: Real>(
+    fs: &[[T; 3]],
+    t0: T,
+    t1: T,
+    vis_at: &impl Fn(T) -> bool,
+    candidates: &mut [(T, u64); MAX_CANDIDATES],
+    line: &mut Line<T>,
+) -> bool {
+    let mut n = 0usize;
+    let mut overflow = false;
+    for (id, &f) in fs.iter().enumerate() {
+        trigonometric_roots(f, t0, t1, &mut |t| match candidates.get_mut(n) {
+            Some(slot) => {
+                *slot = (t, id as u64 + 1);
+                n += 1;
+            }
+            None => overflow = true,
+        });
+    }
+    !overflow && line_from_candidates(candidates.get_mut(..n).unwrap_or_default(), t0, t1, vis_at, line)
+}
+
+/// The roots in (t0, t1) of a + b·cos t + c·sin t: with ρ = √(b² + c²) and δ = atan2(c, b) it
+/// is a + ρ·cos(t − δ), so t = δ ± acos(−a/ρ) + 2πk; each root is polished by Newton steps
+/// (which also recover the accuracy acos loses near ±1). A double root (the line tangent to a
+/// boundary) does not change the sign and may be missed.
+#[cfg(feature = "closed-form")]
+pub(super) fn trigonometric_roots<T: Real>([a, b, c]: [T; 3], t0: T, t1: T, out: &mut impl FnMut(T)) {
+    let rho = (b * b + c * c).sqrt();
+    if !(rho > T::ZERO) || !(t1 > t0) {
+        return;
+    }
+    let x = -a / rho;
+    if !(x.abs() <= T::ONE) {
+        return;
+    }
+    let alpha = (T::ONE - x * x).max(T::ZERO).sqrt().atan2(x);
+    let delta = c.atan2(b);
+    let period = T::TWO * T::PI;
+    let f = |t: T| a + b * t.cos() + c * t.sin();
+    let families = if alpha > T::ZERO { 2 } else { 1 };
+    for base in [delta + alpha, delta - alpha].into_iter().take(families) {
+        // The first root of this family at or above t0 − 2π, then every period up to t1 (a
+        // parameter range spans a few periods at most: the loops are bounded).
+        let mut t = base;
+        let mut steps = 0;
+        while t > t0 && steps < 64 {
+            t -= period;
+            steps += 1;
+        }
+        while t < t0 && steps < 128 {
+            t += period;
+            steps += 1;
+        }
+        while t < t1 && steps < 192 {
+            let mut root = t;
+            for _ in 0..2 {
+                let slope = c * root.cos() - b * root.sin();
+                if !(slope.abs() > T::ZERO) {
+                    break;
+                }
+                let next = root - f(root) / slope;
+                if !(next.is_finite() && f(next).abs() <= f(root).abs()) {
+                    break;
+                }
+                root = next;
+            }
+            if root > t0 && root < t1 {
+                out(root);
+            }
+            t += period;
+            steps += 1;
+        }
+    }
 }
 
 /// (q(x))² for a quadratic q, as quartic coefficients (ascending powers).
@@ -320,5 +410,60 @@ pub(super) fn roots_in_interval<T: Real>(c: &[T; 5], x0: T, x1: T, out: &mut dyn
             }
         }
         out((lo + hi) * T::HALF);
+    }
+}
+
+#[cfg(all(test, feature = "closed-form"))]
+mod tests {
+    use super::*;
+
+    /// Every sign change of a + b·cos t + c·sin t on a fine grid over (t0, t1) holds a root the
+    /// closed form reports, and every reported root is one (|f| at rounding level), over
+    /// random coefficients and ranges of up to three periods, near-tangent cases included.
+    #[test]
+    fn trigonometric_roots_are_every_sign_change() {
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let mut changes = 0;
+        for k in 0..3000 {
+            let (b, c) = (next() * 3.0, next() * 3.0);
+            let rho = (b * b + c * c).sqrt();
+            // Every fourth case is within 1e-3 of tangent.
+            let a = if k % 4 == 0 { rho * (1.0 - 1e-3 * next().abs()) * next().signum() } else { next() * 4.0 };
+            let t0 = next() * 8.0;
+            let t1 = t0 + 0.1 + next().abs() * 18.0;
+            let f = |t: f64| a + b * t.cos() + c * t.sin();
+            let (mut found, mut count) = ([0.0_f64; 64], 0usize);
+            trigonometric_roots([a, b, c], t0, t1, &mut |t| {
+                found[count] = t;
+                count += 1;
+            });
+            let roots = &found[..count];
+            for &t in roots {
+                assert!(t > t0 && t < t1);
+                assert!(f(t).abs() <= 1e-12 * (a.abs() + rho), "k = {k}: f({t}) = {}", f(t));
+            }
+            let n = 20_000;
+            let mut prev = f(t0);
+            for i in 1..=n {
+                let x = t0 + (t1 - t0) * i as f64 / n as f64;
+                let y = f(x);
+                if (prev > 0.0) != (y > 0.0) && prev != 0.0 && y != 0.0 {
+                    let lo = x - (t1 - t0) / n as f64;
+                    assert!(
+                        roots.iter().any(|&r| r >= lo - 1e-9 && r <= x + 1e-9),
+                        "k = {k}: sign change in [{lo}, {x}] without a root ({roots:?})"
+                    );
+                    changes += 1;
+                }
+                prev = y;
+            }
+        }
+        assert!(changes > 3000);
     }
 }

@@ -188,6 +188,10 @@ where
         probes: 2 * order + 3,
         affine: if closed_form { affine } else { None },
         #[cfg(feature = "closed-form")]
+        trigonometric: affine.is_none()
+            && !use_occluders
+            && surface.facing_along_t(r.s0, Vec3::ZERO, vec3(T::ZERO, T::ZERO, T::ONE)).is_some(),
+        #[cfg(feature = "closed-form")]
         outline: if affine.is_none() { crate::contour::Outline::new(b) } else { None },
         #[cfg(feature = "closed-form")]
         line_rule: GaussRule::<T>::new(order.max(16))?,

@@ -148,6 +148,18 @@ pub trait Surface<T: Real> {
         let at = |t: T, s: T| o + et.scale(t) + es.scale(s);
         Some([at(rect.t0, rect.s0), at(rect.t1, rect.s0), at(rect.t1, rect.s1), at(rect.t0, rect.s1)])
     }
+    /// `Some([f₁, f₂])` if, along the t-line at `s`, both facing tests of section 3.2 between a
+    /// point p (unit normal `np`) and the line's points q(t) are first-degree trigonometric
+    /// polynomials in t: f = [a, b, c] stands for a + b·cos t + c·sin t, and f₁ has the sign of
+    /// n̂_p·(q − p), f₂ that of n̂_q·(p − q), wherever the normal is not zero (a sphere's
+    /// meridians). Visibility changes along such a line are then the roots of f₁ and f₂, which
+    /// `boundary/` solves in closed form instead of bracketing and bisecting. Default: `None`.
+    #[cfg(feature = "closed-form")]
+    #[inline]
+    fn facing_along_t(&self, s: T, p: Vec3<T>, np: Vec3<T>) -> Option<[[T; 3]; 2]> {
+        let _ = (s, p, np);
+        None
+    }
 }
 
 impl<T: Real, S: Surface<T> + ?Sized> Surface<T> for &S {
@@ -174,6 +186,10 @@ impl<T: Real, S: Surface<T> + ?Sized> Surface<T> for &S {
     #[cfg(feature = "closed-form")]
     fn straight_corners(&self, rect: ParamRect<T>) -> Option<[Vec3<T>; 4]> {
         (**self).straight_corners(rect)
+    }
+    #[cfg(feature = "closed-form")]
+    fn facing_along_t(&self, s: T, p: Vec3<T>, np: Vec3<T>) -> Option<[[T; 3]; 2]> {
+        (**self).facing_along_t(s, p, np)
     }
 }
 
@@ -267,6 +283,12 @@ impl<T: Real, S: Surface<T>> Surface<T> for Flipped<S> {
     #[cfg(feature = "closed-form")]
     fn straight_corners(&self, rect: ParamRect<T>) -> Option<[Vec3<T>; 4]> {
         self.0.straight_corners(rect)
+    }
+    /// The surface's, with the test on q's side negated (its normal is).
+    #[cfg(feature = "closed-form")]
+    fn facing_along_t(&self, s: T, p: Vec3<T>, np: Vec3<T>) -> Option<[[T; 3]; 2]> {
+        let [f1, [a, b, c]] = self.0.facing_along_t(s, p, np)?;
+        Some([f1, [-a, -b, -c]])
     }
 }
 

@@ -118,6 +118,22 @@ impl<T: Real> Surface<T> for Sphere<T> {
     fn point_and_partials(&self, t: T, s: T) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {
         Some(super::dual_partials(self, t, s))
     }
+    /// Along a meridian θ = s: q(φ) = c + r·(cos φ·axis + sin φ·u_θ), u_θ = cos θ·u + sin θ·w,
+    /// and n̂_q = ±(cos φ·axis + sin φ·u_θ) for φ ∈ (0, π). So n̂_p·(q − p) =
+    /// n̂_p·(c − p) + r (n̂_p·axis) cos φ + r (n̂_p·u_θ) sin φ, and n̂_q·(p − q) =
+    /// ±((p − c)·axis cos φ + (p − c)·u_θ sin φ − r).
+    #[cfg(feature = "closed-form")]
+    fn facing_along_t(&self, theta: T, p: Vec3<T>, np: Vec3<T>) -> Option<[[T; 3]; 2]> {
+        let (st, ct) = (theta.sin(), theta.cos());
+        let axis = self.frame.combine(T::ZERO, T::ZERO, T::ONE);
+        let u = self.frame.combine(ct, st, T::ZERO);
+        let r = self.radius;
+        let d = p - self.center;
+        let from_p = [-np.dot(d), r * np.dot(axis), r * np.dot(u)];
+        let from_q = [-r, d.dot(axis), d.dot(u)];
+        let from_q = if self.side == Side::Inner { from_q.map(|x| -x) } else { from_q };
+        Some([from_p, from_q])
+    }
 }
 
 #[cfg(test)]
@@ -168,5 +184,47 @@ mod tests {
         assert_eq!(Sphere::outer(vec3(0.0, f64::NAN, 0.0), 1.0), Err(PdmError::NonFinite));
         assert_eq!(Sphere::outer(vec3(0.0, 0.0, 0.0), f64::INFINITY), Err(PdmError::NonFinite));
         assert_eq!(Sphere::outer(vec3(0.0_f32, 0.0, 0.0), -1.0), Err(PdmError::Degenerate));
+    }
+
+    /// `facing_along_t` gives both facing tests along a meridian up to a positive factor: its
+    /// signs agree with n̂_p·(q − p) and n̂_q·(p − q) computed from the points and normals,
+    /// for both sides, a moved centre, points inside and outside, and through `Flipped`.
+    #[cfg(feature = "closed-form")]
+    #[test]
+    fn facing_along_t_has_the_signs_of_the_facing_tests() {
+        use crate::surface::Flipped;
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut checked = 0;
+        for k in 0..4000 {
+            let centre = vec3(next() * 4.0 - 2.0, next() * 4.0 - 2.0, next() * 4.0 - 2.0);
+            let radius = 0.2 + next() * 2.0;
+            let sphere =
+                if k % 2 == 0 { Sphere::outer(centre, radius) } else { Sphere::inner(centre, radius) }.unwrap();
+            let p = vec3(next() * 8.0 - 4.0, next() * 8.0 - 4.0, next() * 8.0 - 4.0);
+            let np = vec3(next() - 0.5, next() - 0.5, next() - 0.5);
+            let np = np.scale(1.0 / np.norm());
+            let (phi, theta) = (0.01 + next() * (core::f64::consts::PI - 0.02), next() * 7.0 - 0.5);
+            let eval = |[a, b, c]: [f64; 3]| a + b * phi.cos() + c * phi.sin();
+            let (q, nq) = sphere.point_and_normal(phi, theta);
+            let nq = nq.scale(1.0 / nq.norm());
+            let (towards_q, towards_p) = (np.dot(q - p), nq.dot(p - q));
+            let [f1, f2] = sphere.facing_along_t(theta, p, np).unwrap();
+            let [g1, g2] = Flipped(sphere).facing_along_t(theta, p, np).unwrap();
+            for (got, want) in
+                [(eval(f1), towards_q), (eval(f2), towards_p), (eval(g1), towards_q), (eval(g2), -towards_p)]
+            {
+                if want.abs() > 1e-9 {
+                    assert_eq!(got > 0.0, want > 0.0, "k = {k}: {got} against {want}");
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked > 15_000);
     }
 }
