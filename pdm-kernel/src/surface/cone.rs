@@ -94,6 +94,22 @@ impl<T: Real> Surface<T> for Cone<T> {
     fn point_and_partials(&self, t: T, s: T) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {
         Some(super::dual_partials(self, t, s))
     }
+    /// Along the circle z = s, of radius ρ = base radius + slope·z: q(θ) = base + z·axis +
+    /// ρ·(cos θ·u + sin θ·w), and n = ρ·((cos θ·u + sin θ·w) − slope·axis) (ρ ≥ 0; zero at an
+    /// apex). So n̂_p·(q − p) = n̂_p·(base + z·axis − p) + ρ (n̂_p·u) cos θ + ρ (n̂_p·w) sin θ,
+    /// and n̂_q·(p − q) has the sign of ±(d·u cos θ + d·w sin θ − ρ − slope·(d·axis − z)),
+    /// d = p − base.
+    #[cfg(feature = "closed-form")]
+    fn facing_along_t(&self, z: T, p: Vec3<T>, np: Vec3<T>) -> Option<[[T; 3]; 2]> {
+        let (u, w, axis) = (self.frame.u, self.frame.w, self.frame.axis);
+        let slope = self.slope();
+        let rho = self.base_radius + slope * z;
+        let d = p - self.base;
+        let from_p = [np.dot(self.base + axis.scale(z) - p), rho * np.dot(u), rho * np.dot(w)];
+        let from_q = [-rho - slope * (d.dot(axis) - z), d.dot(u), d.dot(w)];
+        let from_q = if self.side == Side::Inner { from_q.map(|x| -x) } else { from_q };
+        Some([from_p, from_q])
+    }
 }
 
 #[cfg(test)]
@@ -101,6 +117,18 @@ mod tests {
     use super::super::test_support::*;
     use super::*;
     use crate::vec3::vec3;
+
+    #[cfg(feature = "closed-form")]
+    #[test]
+    fn facing_along_t_has_the_signs_of_the_facing_tests() {
+        for side in [Side::Outer, Side::Inner] {
+            // A cone to its apex, a frustum widening upwards and one narrowing.
+            for (r0, r1) in [(1.2, 0.0), (0.3, 1.1), (0.9, 0.4)] {
+                let c = Cone::new(vec3(0.5, 0.0, -1.0), vec3(0.0, 1.0, 1.0), r0, r1, 2.0, side).unwrap();
+                assert!(facing_along_t_matches(c, 4.0, 3000) > 11_000);
+            }
+        }
+    }
 
     #[test]
     fn closed_form_agrees_with_dual_numbers() {

@@ -98,6 +98,19 @@ impl<T: Real> Surface<T> for Cylinder<T> {
     fn point_and_partials(&self, t: T, s: T) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {
         Some(super::dual_partials(self, t, s))
     }
+    /// Along the circle z = s: q(θ) = base + z·axis + r·(cos θ·u + sin θ·w), n̂_q = ±(cos θ·u +
+    /// sin θ·w). So n̂_p·(q − p) = n̂_p·(base + z·axis − p) + r (n̂_p·u) cos θ + r (n̂_p·w) sin θ,
+    /// and n̂_q·(p − q) = ±(d·u cos θ + d·w sin θ − r) with d = p − base.
+    #[cfg(feature = "closed-form")]
+    fn facing_along_t(&self, z: T, p: Vec3<T>, np: Vec3<T>) -> Option<[[T; 3]; 2]> {
+        let (u, w, axis) = (self.frame.u, self.frame.w, self.frame.axis);
+        let r = self.radius;
+        let d = p - self.base;
+        let from_p = [np.dot(self.base + axis.scale(z) - p), r * np.dot(u), r * np.dot(w)];
+        let from_q = [-r, d.dot(u), d.dot(w)];
+        let from_q = if self.side == Side::Inner { from_q.map(|x| -x) } else { from_q };
+        Some([from_p, from_q])
+    }
 }
 
 #[cfg(test)]
@@ -112,6 +125,15 @@ mod tests {
             let c = Cylinder::new(vec3(1.0, 0.0, -1.0), vec3(1.0, 1.0, 1.0), 0.7, 2.5, side).unwrap();
             closed_form_matches_auto(&c, 1e-14);
             normal_matches_finite_differences(&c, 1e-8);
+        }
+    }
+
+    #[cfg(feature = "closed-form")]
+    #[test]
+    fn facing_along_t_has_the_signs_of_the_facing_tests() {
+        for side in [Side::Outer, Side::Inner] {
+            let c = Cylinder::new(vec3(1.0, 0.0, -1.0), vec3(1.0, 1.0, 1.0), 0.7, 2.5, side).unwrap();
+            assert!(facing_along_t_matches(c, 4.0, 3000) > 11_000);
         }
     }
 

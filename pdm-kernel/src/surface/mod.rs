@@ -375,6 +375,49 @@ pub(crate) fn check_finite<T: Real>(values: &[T]) -> Result<(), PdmError> {
 pub(crate) mod test_support {
     use super::*;
 
+    /// Checks [`Surface::facing_along_t`] against the facing tests computed from points and
+    /// normals: at `cases` random (t, s) inside the domain, points p in a box of half-width
+    /// `reach` around the origin and random unit normals, each form's sign equals that of
+    /// n̂_p·(q − p) and n̂_q·(p − q) wherever those are not within 1e-9 of zero; the same
+    /// through [`Flipped`]. Returns how many signs were compared.
+    #[cfg(feature = "closed-form")]
+    pub(crate) fn facing_along_t_matches<S: Surface<f64> + Copy>(surface: S, reach: f64, cases: usize) -> usize {
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let d = surface.domain();
+        let mut checked = 0;
+        for k in 0..cases {
+            let t = d.t0 + (d.t1 - d.t0) * (0.005 + 0.99 * next());
+            let s = d.s0 + (d.s1 - d.s0) * next();
+            let p = vec3(next() * 2.0 - 1.0, next() * 2.0 - 1.0, next() * 2.0 - 1.0).scale(reach);
+            let np = vec3(next() - 0.5, next() - 0.5, next() - 0.5);
+            let np = np.scale(1.0 / np.norm());
+            let (q, nq) = surface.point_and_normal(t, s);
+            if !(nq.norm() > 1e-12) {
+                continue;
+            }
+            let nq = nq.scale(1.0 / nq.norm());
+            let (towards_q, towards_p) = (np.dot(q - p), nq.dot(p - q));
+            let eval = |[a, b, c]: [f64; 3]| a + b * t.cos() + c * t.sin();
+            let [f1, f2] = surface.facing_along_t(s, p, np).expect("a trigonometric surface");
+            let [g1, g2] = Flipped(surface).facing_along_t(s, p, np).expect("through Flipped");
+            for (got, want) in
+                [(eval(f1), towards_q), (eval(f2), towards_p), (eval(g1), towards_q), (eval(g2), -towards_p)]
+            {
+                if want.abs() > 1e-9 {
+                    assert_eq!(got > 0.0, want > 0.0, "case {k} at ({t}, {s}): {got} against {want}");
+                    checked += 1;
+                }
+            }
+        }
+        checked
+    }
+
     /// Checks that a built-in's closed-form normal equals the automatic one (dual numbers) and
     /// that `point` equals the map, at a grid of interior parameter points.
     pub(crate) fn closed_form_matches_auto<S>(surface: &S, rel_tol: f64)

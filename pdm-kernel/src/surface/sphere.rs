@@ -200,6 +200,11 @@ mod tests {
             state ^= state << 17;
             (state >> 11) as f64 / (1u64 << 53) as f64
         };
+        for side in [Side::Outer, Side::Inner] {
+            // The shared check too, over the whole domain from points around the sphere.
+            let sphere = Sphere::new(vec3(0.3, -0.2, 0.5), 1.3, side).unwrap();
+            assert!(facing_along_t_matches(sphere, 4.0, 3000) > 11_000);
+        }
         let mut checked = 0;
         for k in 0..4000 {
             let centre = vec3(next() * 4.0 - 2.0, next() * 4.0 - 2.0, next() * 4.0 - 2.0);
