@@ -11,9 +11,12 @@
 //!   when b is a parallelogram ([`Surface::affine_map`]) and every occluder gives its
 //!   polynomials ([`Occluder::line_polynomials`]: sphere, parallelogram, disk, and their
 //!   combinations): the roots of the two facing tests (linear in t) and of the occluders'
-//!   quadratics, each piece between roots classified by the exact test at its midpoint;
-//!   otherwise bracketed on 2·order + 3 probes and bisected to machine precision. Each visible
-//!   piece gets its own Gauss rule.
+//!   quadratics, each piece between roots classified by the exact test at its midpoint; when
+//!   b's t-lines are circles on which both facing tests are first-degree trigonometric
+//!   polynomials ([`Surface::facing_along_t`]: a sphere's meridians, a cylinder's or a cone's
+//!   circles) and no occluder can cut, the roots of those, in closed form, likewise; otherwise
+//!   bracketed on 2·order + 3 probes and bisected to machine precision. Each visible piece gets
+//!   its own Gauss rule.
 //! * **Along s**, the line integral is smooth except where the lines' visibility structure
 //!   changes: a boundary crossing a t-edge (a kink) or tangent to the t-lines (two breaks
 //!   meeting, a square-root end point). In closed form these are roots of a quadratic in s
