@@ -86,23 +86,59 @@ fn kernel_modules_import_only_the_layers_below() {
             let mut rest = code_part;
             while let Some(k) = rest.find("crate::") {
                 rest = &rest[k + "crate::".len()..];
-                let target: String = rest.chars().take_while(|c| c.is_ascii_alphanumeric() || *c == '_').collect();
-                if target == top || target.is_empty() {
-                    continue;
-                }
-                if target.starts_with(|c: char| c.is_ascii_uppercase()) {
-                    problems.push(format!("{rel}:{}: `crate::{target}` hides its module: name it", n + 1));
-                    continue;
-                }
-                match rank.get(target.as_str()) {
-                    None => problems.push(format!("{rel}:{}: `crate::{target}` is not in the diagram", n + 1)),
-                    Some(&r) if r < own => {
-                        problems.push(format!("{rel}:{}: `{top}` imports `{target}`, which is above it", n + 1));
+                for target in module_names(rest) {
+                    if target == top {
+                        continue;
                     }
-                    Some(_) => {}
+                    if target.starts_with(|c: char| c.is_ascii_uppercase()) {
+                        problems.push(format!("{rel}:{}: `crate::{target}` hides its module: name it", n + 1));
+                        continue;
+                    }
+                    match rank.get(target.as_str()) {
+                        None => problems.push(format!("{rel}:{}: `crate::{target}` is not in the diagram", n + 1)),
+                        Some(&r) if r < own => {
+                            problems.push(format!("{rel}:{}: `{top}` imports `{target}`, which is above it", n + 1));
+                        }
+                        Some(_) => {}
+                    }
                 }
             }
         }
     }
     assert!(problems.is_empty(), "layering broken:\n{}", problems.join("\n"));
+}
+
+/// The modules a path after `crate::` names: its first word, or for a group `{a::x, b, c::{…}}`
+/// the first word of each element (a group that continues on the next lines is read as far as
+/// this line goes).
+fn module_names(rest: &str) -> Vec<String> {
+    let word =
+        |s: &str| -> String { s.trim_start().chars().take_while(|c| c.is_ascii_alphanumeric() || *c == '_').collect() };
+    let Some(group) = rest.strip_prefix('{') else {
+        return vec![word(rest)].into_iter().filter(|w| !w.is_empty()).collect();
+    };
+    let (mut names, mut depth, mut start) = (Vec::new(), 0usize, 0usize);
+    for (i, ch) in group.char_indices() {
+        match ch {
+            '{' => depth += 1,
+            '}' if depth == 0 => {
+                names.push(word(&group[start..i]));
+                break;
+            }
+            '}' => depth -= 1,
+            ',' if depth == 0 => {
+                names.push(word(&group[start..i]));
+                start = i + 1;
+            }
+            _ => {}
+        }
+    }
+    names.retain(|w| !w.is_empty());
+    names
+}
+
+#[test]
+fn module_names_reads_paths_and_groups() {
+    assert_eq!(module_names("pair::route(a)"), vec!["pair"]);
+    assert_eq!(module_names("{sum::exchange, pair::{a, b}, real::Real};"), vec!["sum", "pair", "real"]);
 }

@@ -99,7 +99,11 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
             let (q, nq) = self.surface.point_and_normal(t, s);
             self.visible(p, np, q, nq)
         };
-        if self.affine.is_some() {
+        #[cfg(feature = "closed-form")]
+        let closed = self.affine.is_some() || self.trigonometric;
+        #[cfg(not(feature = "closed-form"))]
+        let closed = self.affine.is_some();
+        if closed {
             // Reused buffers (zeroing them on every line cost ≈ 6 % of the run time); a fresh
             // set if they are in use (never: lines are not computed re-entrantly).
             let mut fresh = None;
@@ -109,22 +113,18 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
                 Err(_) => fresh.insert(LineScratch::new()),
             };
             let LineScratch { polys, candidates } = scratch;
-            if self.line_polys(p, np, s, polys) && closed_form_line(polys.used(), r.t0, r.t1, &vis_at, candidates, line)
+            if self.affine.is_some()
+                && self.line_polys(p, np, s, polys)
+                && closed_form_line(polys.used(), r.t0, r.t1, &vis_at, candidates, line)
             {
                 return Ok(());
             }
-        }
-        #[cfg(feature = "closed-form")]
-        if self.trigonometric {
-            if let Some(fs) = self.surface.facing_along_t(s, p, np) {
-                let mut fresh = None;
-                let mut borrowed = self.scratch.try_borrow_mut();
-                let scratch: &mut LineScratch<T> = match borrowed.as_deref_mut() {
-                    Ok(scratch) => scratch,
-                    Err(_) => fresh.insert(LineScratch::new()),
-                };
-                if trigonometric_line(&fs, r.t0, r.t1, &vis_at, &mut scratch.candidates, line) {
-                    return Ok(());
+            #[cfg(feature = "closed-form")]
+            if self.trigonometric {
+                if let Some(fs) = self.surface.facing_along_t(s, p, np) {
+                    if trigonometric_line(&fs, r.t0, r.t1, &vis_at, candidates, line) {
+                        return Ok(());
+                    }
                 }
             }
         }

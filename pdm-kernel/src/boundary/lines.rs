@@ -260,13 +260,14 @@ pub(super) fn trigonometric_line<T: Real>(
     let mut n = 0usize;
     let mut overflow = false;
     for (id, &f) in fs.iter().enumerate() {
-        trigonometric_roots(f, t0, t1, &mut |t| match candidates.get_mut(n) {
+        let complete = trigonometric_roots(f, t0, t1, &mut |t| match candidates.get_mut(n) {
             Some(slot) => {
                 *slot = (t, id as u64 + 1);
                 n += 1;
             }
             None => overflow = true,
         });
+        overflow |= !complete;
     }
     !overflow && line_from_candidates(candidates.get_mut(..n).unwrap_or_default(), t0, t1, vis_at, line)
 }
@@ -274,36 +275,56 @@ pub(super) fn trigonometric_line<T: Real>(
 /// The roots in (t0, t1) of a + b·cos t + c·sin t: with ρ = √(b² + c²) and δ = atan2(c, b) it
 /// is a + ρ·cos(t − δ), so t = δ ± acos(−a/ρ) + 2πk; each root is polished by Newton steps
 /// (which also recover the accuracy acos loses near ±1). A double root (the line tangent to a
-/// boundary) does not change the sign and may be missed.
+/// boundary) does not change the sign and may be missed. `false` if the roots could not all be
+/// found (coefficients not finite, a range of more than 60 periods): the caller then brackets.
 #[cfg(feature = "closed-form")]
-pub(super) fn trigonometric_roots<T: Real>([a, b, c]: [T; 3], t0: T, t1: T, out: &mut impl FnMut(T)) {
+pub(super) fn trigonometric_roots<T: Real>(f: [T; 3], t0: T, t1: T, out: &mut impl FnMut(T)) -> bool {
+    // Scaled by the largest coefficient, so that b² + c² neither underflows nor overflows.
+    let scale = f.iter().fold(T::ZERO, |m, x| m.max(x.abs()));
+    if !f.iter().all(|x| x.is_finite()) || !t0.is_finite() || !t1.is_finite() {
+        return false;
+    }
+    if !(scale > T::ZERO) || !(t1 > t0) {
+        return true;
+    }
+    let [a, b, c] = f.map(|x| x / scale);
+    let period = T::TWO * T::PI;
+    if (t1 - t0) > T::from_usize(60) * period {
+        return false;
+    }
     let rho = (b * b + c * c).sqrt();
-    if !(rho > T::ZERO) || !(t1 > t0) {
-        return;
+    if !(rho > T::ZERO) {
+        return true;
     }
     let x = -a / rho;
     if !(x.abs() <= T::ONE) {
-        return;
+        return true;
     }
     let alpha = (T::ONE - x * x).max(T::ZERO).sqrt().atan2(x);
     let delta = c.atan2(b);
-    let period = T::TWO * T::PI;
     let f = |t: T| a + b * t.cos() + c * t.sin();
     let families = if alpha > T::ZERO { 2 } else { 1 };
     for base in [delta + alpha, delta - alpha].into_iter().take(families) {
         // The first root of this family at or above t0 − 2π, then every period up to t1 (a
         // parameter range spans a few periods at most: the loops are bounded).
+        // (base lies in (−2π, 2π]; a range more than 256 periods away from it is refused.)
         let mut t = base;
         let mut steps = 0;
-        while t > t0 && steps < 64 {
+        while t > t0 {
             t -= period;
             steps += 1;
+            if steps > 256 {
+                return false;
+            }
         }
-        while t < t0 && steps < 128 {
+        while t < t0 {
             t += period;
             steps += 1;
+            if steps > 256 {
+                return false;
+            }
         }
-        while t < t1 && steps < 192 {
+        while t < t1 {
             let mut root = t;
             for _ in 0..2 {
                 let slope = c * root.cos() - b * root.sin();
@@ -320,9 +341,9 @@ pub(super) fn trigonometric_roots<T: Real>([a, b, c]: [T; 3], t0: T, t1: T, out:
                 out(root);
             }
             t += period;
-            steps += 1;
         }
     }
+    true
 }
 
 /// (q(x))² for a quadratic q, as quartic coefficients (ascending powers).
@@ -439,10 +460,11 @@ mod tests {
             let t1 = t0 + 0.1 + next().abs() * 18.0;
             let f = |t: f64| a + b * t.cos() + c * t.sin();
             let (mut found, mut count) = ([0.0_f64; 64], 0usize);
-            trigonometric_roots([a, b, c], t0, t1, &mut |t| {
+            let complete = trigonometric_roots([a, b, c], t0, t1, &mut |t| {
                 found[count] = t;
                 count += 1;
             });
+            assert!(complete);
             let roots = &found[..count];
             for &t in roots {
                 assert!(t > t0 && t < t1);
@@ -465,5 +487,19 @@ mod tests {
             }
         }
         assert!(changes > 3000);
+        // Scaled coefficients: the same roots at 1e-30 and 1e30 in f32 as at 1.
+        for scale in [1e-30_f32, 1.0, 1e30] {
+            let (mut roots, mut n) = ([0.0_f32; 4], 0);
+            assert!(trigonometric_roots([0.5 * scale, scale, 0.0], 0.0, 6.0, &mut |t| {
+                roots[n] = t;
+                n += 1;
+            }));
+            assert_eq!(n, 2, "scale {scale}");
+            assert!((roots[0] - 2.0 * core::f32::consts::FRAC_PI_3).abs() < 1e-5);
+        }
+        // What cannot be solved is refused, so that the caller brackets instead.
+        assert!(!trigonometric_roots([f64::NAN, 1.0, 0.0], 0.0, 1.0, &mut |_| {}));
+        assert!(!trigonometric_roots([0.0, 1.0, 0.0], 0.0, 1e4, &mut |_| {}));
+        assert!(!trigonometric_roots([0.0, 1.0, 0.0], 1e6, 1e6 + 1.0, &mut |_| {}));
     }
 }
