@@ -206,6 +206,12 @@ impl<T: Real> Occluder<T> for SceneOccluder<T> {
             Self::Part(_) => false,
         }
     }
+    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Vec3<T>, [T; 6])) -> bool {
+        match self {
+            Self::Whole(o) => o.event_quadrics(corner, edge, out),
+            Self::Part(_) => false,
+        }
+    }
 }
 
 #[cfg(test)]

@@ -4,6 +4,10 @@
 
 use super::*;
 
+/// Tag of a candidate that is a discriminant root (two roots of one polynomial meeting), or-ed
+/// into its polynomial index.
+const BRANCH_POINT: usize = 1 << 16;
+
 /// The inner patch b with everything needed to integrate over its visible part from one point.
 pub(super) struct Inner<'x, T: Real, SB: Surface<T> + ?Sized, O: ?Sized> {
     pub(super) surface: &'x SB,
@@ -200,17 +204,18 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
         for (id, (((&[a0, b0, k0], &[ah, bh, kh]), &[a1, b1, k1]), slot)) in polys.zip(fits.iter_mut()).enumerate() {
             let (qa, qb, qc) = (fit(a0, ah, a1), fit(b0, bh, b1), fit(k0, kh, k1));
             *slot = [qa, qb, qc];
-            let mut add = |x: T| {
+            let mut add_tagged = |x: T, tag: usize| {
                 if x > -reach && x < T::ONE + reach {
                     match candidates.get_mut(nc) {
                         Some(c) => {
-                            *c = (r.s0 + h * x, id);
+                            *c = (r.s0 + h * x, id | tag);
                             nc += 1;
                         }
                         None => overflow = true,
                     }
                 }
             };
+            let mut add = |x: T| add_tagged(x, 0);
             // A root crossing the t-edges: P(t_edge; x) = a(x) t² + b(x) t + c(x), coefficient by
             // coefficient in x.
             for t in [r.t0, r.t1] {
@@ -232,7 +237,7 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
                     bb[3] - four * ac[3],
                     bb[4] - four * ac[4],
                 ];
-                roots_in_interval(&d, -reach, T::ONE + reach, &mut add);
+                roots_in_interval(&d, -reach, T::ONE + reach, &mut |x| add_tagged(x, BRANCH_POINT));
             }
         }
         let fits = fits.get(..p0.n).unwrap_or_default();
@@ -246,7 +251,7 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
             let x = (from - r.s0) / h;
             let mut count = 0;
             for (id, [qa, qb, qc]) in fits.iter().enumerate() {
-                let mut inside = candidates.iter().any(|&(c, i)| i == id && c > from && c < hi);
+                let mut inside = candidates.iter().any(|&(c, i)| i & !BRANCH_POINT == id && c > from && c < hi);
                 if !inside {
                     let at = |q: &[T; 3]| horner(q, x);
                     crate::visibility::polynomial_roots(at(qa), at(qb), at(qc), &mut |t| {
@@ -263,11 +268,27 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
         let mut kept = 0usize;
         let mut last = r.s0 - h;
         let mut outside: Outside<T> = (None, None);
-        for &(c, _) in candidates {
+        for &(c, tag) in candidates {
             if c - last <= delta {
                 continue;
             }
-            if self.line_signature(p, np, r, c - delta) != self.line_signature(p, np, r, c + delta) {
+            let changes = self.line_signature(p, np, r, c - delta) != self.line_signature(p, np, r, c + delta);
+            if !changes && tag & BRANCH_POINT != 0 {
+                // Two roots of one polynomial meeting outside b's t-range: the structure does
+                // not change there, but a root that is inside on a neighbouring piece grows like
+                // √(s − c) from it, a branch point just beyond that piece's end. As a break it
+                // grades that piece towards it (`for_each_piece`); the piece it bounds on the
+                // other side is smooth.
+                if c > r.s0 + delta && c < r.s1 - delta {
+                    push(out, n, c)?;
+                } else if c <= r.s0 + delta {
+                    outside.0 = Some(outside.0.map_or(c, |o: T| o.max(c)).min(r.s0 - delta));
+                } else if outside.1.is_none() {
+                    outside.1 = Some(c.max(r.s1 + delta));
+                }
+                continue;
+            }
+            if changes {
                 last = c;
                 if c <= r.s0 + delta {
                     outside.0 = Some(c.min(r.s0 - delta));

@@ -81,9 +81,13 @@ use crate::vec3::{vec3, Vec3};
 use crate::visibility::Occluder;
 
 mod breaks;
+#[cfg(feature = "closed-form")]
+mod events;
 mod inner;
 mod lines;
 use breaks::*;
+#[cfg(feature = "closed-form")]
+use events::*;
 use inner::*;
 use lines::*;
 
@@ -210,6 +214,22 @@ where
     // a samples a layer it cannot resolve and its error does not fall with the order. a is then
     // cut into cells, each no closer to b than its own radius (`outer_cells`).
     let (cells, n_cells) = outer_cells(a, b, &inner)?;
+    #[cfg(feature = "closed-form")]
+    if let (Some(outer_map), Some(inner_map)) = (a.surface().affine_map(), inner.affine) {
+        if let Some(total) = events_sum(
+            a,
+            outer_map,
+            inner_map,
+            cells.get(..n_cells).unwrap_or_default(),
+            &inner,
+            inner_samples,
+            &inner_bounds,
+            order,
+        )? {
+            let value = crate::bounds::finite(total * T::FRAC_1_PI)?;
+            return Ok((value, count.get()));
+        }
+    }
     let mut total = T::ZERO;
     if n_cells > 1 {
         for cell in cells.iter().take(n_cells) {
@@ -221,6 +241,71 @@ where
     }
     let value = crate::bounds::finite(total * T::FRAC_1_PI)?;
     Ok((value, count.get()))
+}
+
+/// The outer integral over the cells of a flat a against a flat b with the events placed
+/// into the outer rule (`events.rs`); `None` where the occluders give no events.
+#[cfg(feature = "closed-form")]
+#[inline(never)]
+#[allow(clippy::too_many_arguments)]
+fn events_sum<T, SA, SB, O, const CB: usize>(
+    a: &Patch<'_, T, SA>,
+    outer_map: (Vec3<T>, Vec3<T>, Vec3<T>),
+    inner_map: (Vec3<T>, Vec3<T>, Vec3<T>),
+    cells: &[ParamRect<T>],
+    inner: &Inner<'_, T, SB, O>,
+    inner_samples: &PatchSamples<T, CB>,
+    inner_bounds: &Ball<T>,
+    order: usize,
+) -> Result<Option<T>, PdmError>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
+    let events = if inner.use_occluders {
+        Events::new(outer_map, inner_map, inner.r, inner.occluders)
+    } else {
+        Events::new(outer_map, inner_map, inner.r, &())
+    };
+    let Some(events) = events else { return Ok(None) };
+    let rule = GaussRule::<T>::new(order)?;
+    let surface = a.surface();
+    let mut f = |t: T, s: T| -> Result<T, PdmError> {
+        let (p, n) = surface.point_and_normal(t, s);
+        let area = n.norm();
+        if !(area > T::ZERO) {
+            return Ok(T::ZERO);
+        }
+        Ok(area * point_value(inner, inner_samples, inner_bounds, p, n.scale(T::ONE / area))?)
+    };
+    let mut total = T::ZERO;
+    for cell in cells {
+        total += events.integrate(*cell, &rule, &mut f)?;
+    }
+    Ok(Some(total))
+}
+
+/// Whether [`boundary_sum`] places the outer events into the rule for this pair with `outer`
+/// outside (both flat, every occluder giving its quadrics): the outer patch is then not
+/// split into cells for its kinks.
+#[cfg(feature = "closed-form")]
+pub(crate) fn outer_events_apply<T, SA, SB, O>(
+    outer: &Patch<'_, T, SA>,
+    inner: &Patch<'_, T, SB>,
+    occluders: &O,
+) -> bool
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
+    match (outer.surface().affine_map(), inner.surface().affine_map()) {
+        (Some(a), Some(b)) => Events::new(a, b, inner.rect(), occluders).is_some(),
+        _ => false,
+    }
 }
 
 /// Most cells into which [`outer_cells`] cuts the outer patch (each costs one outer rule).
@@ -304,52 +389,66 @@ where
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
-    let (use_occluders, occluders, count, r) = (inner.use_occluders, inner.occluders, inner.count, inner.r);
-    let inner_bounds = *inner_bounds;
     let mut total = T::ZERO;
     for sample in outer.iter() {
         if sample.weight == T::ZERO {
             continue;
         }
-        let (p, np) = (sample.point, sample.unit_normal);
-        // From most points nothing cuts b: an occluder can cut only if it meets the cone of
-        // segments from p to b's bounding ball, and on a flat b the facing tests are affine,
-        // so b's corners decide them. The integrand is then smooth (plain rule) or zero.
-        let occluded_from_p =
-            use_occluders && occluders.may_block_between(&Ball { center: p, radius: T::ZERO }, &inner_bounds);
-        if occluded_from_p && occluder_hides(occluders, p, &inner_bounds) {
-            continue;
-        }
-        // A receiver closer to p than its size: its kernel peaks at p's foot, which a rule
-        // over the whole of b cannot resolve; b is then refined towards p.
-        let near = inner.near(p, &inner_bounds);
-        let j = match (occluded_from_p, inner.facing_from(p, np)) {
-            (_, Some(false)) => T::ZERO,
-            (false, Some(true)) if !near => {
-                let (x, y, z, nx, ny, nz, w) = inner_samples.columns();
-                let mut sum = T::ZERO;
-                for k in 0..w.len() {
-                    if let (Some(&qx), Some(&qy), Some(&qz), Some(&ax), Some(&ay), Some(&az), Some(&wk)) =
-                        (x.get(k), y.get(k), z.get(k), nx.get(k), ny.get(k), nz.get(k), w.get(k))
-                    {
-                        sum += wk * kernel(p, np, vec3(qx, qy, qz), vec3(ax, ay, az));
-                    }
-                }
-                count.set(count.get().saturating_add(w.len() as u64));
-                sum
-            }
-            // From a point no occluder cuts b from, on a flat b whose integrand a rule over b
-            // cannot resolve (p near b, or b straddling p's tangent plane), the inner integral
-            // is the point-to-polygon form in closed form.
-            (false, _) if cfg!(feature = "closed-form") => match inner.point_to_polygon(p, np) {
-                Some(j) => j,
-                None => inner.refined(p, np, r, 0)?,
-            },
-            _ => inner.refined(p, np, r, 0)?,
-        };
-        total += sample.weight * j;
+        total += sample.weight * point_value(inner, inner_samples, inner_bounds, sample.point, sample.unit_normal)?;
     }
     Ok(total)
+}
+
+/// J(p): the inner integral over b seen from the outer point p with unit normal np, by the
+/// cheapest method that is exact for p (see the module docs).
+fn point_value<T, SB, O, const CB: usize>(
+    inner: &Inner<'_, T, SB, O>,
+    inner_samples: &PatchSamples<T, CB>,
+    inner_bounds: &Ball<T>,
+    p: Vec3<T>,
+    np: Vec3<T>,
+) -> Result<T, PdmError>
+where
+    T: Real,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
+    let (use_occluders, occluders, count, r) = (inner.use_occluders, inner.occluders, inner.count, inner.r);
+    // From most points nothing cuts b: an occluder can cut only if it meets the cone of
+    // segments from p to b's bounding ball, and on a flat b the facing tests are affine,
+    // so b's corners decide them. The integrand is then smooth (plain rule) or zero.
+    let occluded_from_p =
+        use_occluders && occluders.may_block_between(&Ball { center: p, radius: T::ZERO }, inner_bounds);
+    if occluded_from_p && occluder_hides(occluders, p, inner_bounds) {
+        return Ok(T::ZERO);
+    }
+    // A receiver closer to p than its size: its kernel peaks at p's foot, which a rule
+    // over the whole of b cannot resolve; b is then refined towards p.
+    let near = inner.near(p, inner_bounds);
+    Ok(match (occluded_from_p, inner.facing_from(p, np)) {
+        (_, Some(false)) => T::ZERO,
+        (false, Some(true)) if !near => {
+            let (x, y, z, nx, ny, nz, w) = inner_samples.columns();
+            let mut sum = T::ZERO;
+            for k in 0..w.len() {
+                if let (Some(&qx), Some(&qy), Some(&qz), Some(&ax), Some(&ay), Some(&az), Some(&wk)) =
+                    (x.get(k), y.get(k), z.get(k), nx.get(k), ny.get(k), nz.get(k), w.get(k))
+                {
+                    sum += wk * kernel(p, np, vec3(qx, qy, qz), vec3(ax, ay, az));
+                }
+            }
+            count.set(count.get().saturating_add(w.len() as u64));
+            sum
+        }
+        // From a point no occluder cuts b from, on a flat b whose integrand a rule over b
+        // cannot resolve (p near b, or b straddling p's tangent plane), the inner integral
+        // is the point-to-polygon form in closed form.
+        (false, _) if cfg!(feature = "closed-form") => match inner.point_to_polygon(p, np) {
+            Some(j) => j,
+            None => inner.refined(p, np, r, 0)?,
+        },
+        _ => inner.refined(p, np, r, 0)?,
+    })
 }
 
 /// The distance from `ball` to the part r of a surface, to within the ball's radius (parts

@@ -328,7 +328,19 @@ where
         return Ok((value, p4));
     }
     match pair.separate_route(order)? {
-        SeparateRoute::Occluded { outer_b } => pair.boundary(order, outer_b, OCCLUDED_OUTER_SPLIT, occluders),
+        SeparateRoute::Occluded { outer_b } => {
+            // With the outer events placed into the rule the outer patch needs no cells.
+            #[cfg(feature = "closed-form")]
+            let events = if outer_b {
+                crate::boundary::outer_events_apply(pair.b, pair.a, occluders)
+            } else {
+                crate::boundary::outer_events_apply(pair.a, pair.b, occluders)
+            };
+            #[cfg(not(feature = "closed-form"))]
+            let events = false;
+            let split = if events { 1 } else { OCCLUDED_OUTER_SPLIT };
+            pair.boundary(order, outer_b, split, occluders)
+        }
         SeparateRoute::Boundary { outer_b } => {
             let (value, count) = pair.boundary(order, outer_b, 1, &())?;
             Ok((value, count.saturating_add(p4)))

@@ -66,6 +66,13 @@ impl<T: Real> Occluder<T> for AnyOccluder<T> {
             _ => false,
         }
     }
+    #[cfg(feature = "closed-form")]
+    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Vec3<T>, [T; 6])) -> bool {
+        match self {
+            Self::Sphere(o) => o.event_quadrics(corner, edge, out),
+            _ => false,
+        }
+    }
 }
 
 /// No occluder.
@@ -86,6 +93,10 @@ impl<T: Real> Occluder<T> for () {
     ) -> bool {
         true
     }
+    #[cfg(feature = "closed-form")]
+    fn event_quadrics(&self, _corner: Vec3<T>, _edge: Vec3<T>, _out: &mut dyn FnMut(Vec3<T>, [T; 6])) -> bool {
+        true
+    }
 }
 
 impl<T: Real, O: Occluder<T> + ?Sized> Occluder<T> for &O {
@@ -102,6 +113,10 @@ impl<T: Real, O: Occluder<T> + ?Sized> Occluder<T> for &O {
     #[cfg(feature = "closed-form")]
     fn hides_ball_from(&self, p: Vec3<T>, b: &Ball<T>) -> bool {
         (**self).hides_ball_from(p, b)
+    }
+    #[cfg(feature = "closed-form")]
+    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Vec3<T>, [T; 6])) -> bool {
+        (**self).event_quadrics(corner, edge, out)
     }
 }
 
@@ -120,6 +135,10 @@ impl<T: Real, O: Occluder<T>> Occluder<T> for [O] {
     fn hides_ball_from(&self, p: Vec3<T>, b: &Ball<T>) -> bool {
         self.iter().any(|o| o.hides_ball_from(p, b))
     }
+    #[cfg(feature = "closed-form")]
+    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Vec3<T>, [T; 6])) -> bool {
+        self.iter().all(|o| o.event_quadrics(corner, edge, out))
+    }
 }
 
 impl<T: Real, O: Occluder<T>, const N: usize> Occluder<T> for [O; N] {
@@ -136,6 +155,10 @@ impl<T: Real, O: Occluder<T>, const N: usize> Occluder<T> for [O; N] {
     #[cfg(feature = "closed-form")]
     fn hides_ball_from(&self, p: Vec3<T>, b: &Ball<T>) -> bool {
         self.as_slice().hides_ball_from(p, b)
+    }
+    #[cfg(feature = "closed-form")]
+    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Vec3<T>, [T; 6])) -> bool {
+        self.as_slice().event_quadrics(corner, edge, out)
     }
 }
 
@@ -154,6 +177,10 @@ impl<T: Real, O: Occluder<T>, const N: usize> Occluder<T> for heapless::Vec<O, N
     fn hides_ball_from(&self, p: Vec3<T>, b: &Ball<T>) -> bool {
         self.as_slice().hides_ball_from(p, b)
     }
+    #[cfg(feature = "closed-form")]
+    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Vec3<T>, [T; 6])) -> bool {
+        self.as_slice().event_quadrics(corner, edge, out)
+    }
 }
 
 impl<T: Real, O: Occluder<T>> Occluder<T> for Option<O> {
@@ -171,6 +198,10 @@ impl<T: Real, O: Occluder<T>> Occluder<T> for Option<O> {
     fn hides_ball_from(&self, p: Vec3<T>, b: &Ball<T>) -> bool {
         self.as_ref().is_some_and(|o| o.hides_ball_from(p, b))
     }
+    #[cfg(feature = "closed-form")]
+    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Vec3<T>, [T; 6])) -> bool {
+        self.as_ref().is_none_or(|o| o.event_quadrics(corner, edge, out))
+    }
 }
 
 impl<T: Real, A: Occluder<T>, B: Occluder<T>> Occluder<T> for (A, B) {
@@ -187,6 +218,10 @@ impl<T: Real, A: Occluder<T>, B: Occluder<T>> Occluder<T> for (A, B) {
     #[cfg(feature = "closed-form")]
     fn hides_ball_from(&self, p: Vec3<T>, b: &Ball<T>) -> bool {
         self.0.hides_ball_from(p, b) || self.1.hides_ball_from(p, b)
+    }
+    #[cfg(feature = "closed-form")]
+    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Vec3<T>, [T; 6])) -> bool {
+        self.0.event_quadrics(corner, edge, out) && self.1.event_quadrics(corner, edge, out)
     }
 }
 
@@ -206,5 +241,11 @@ impl<T: Real, A: Occluder<T>, B: Occluder<T>, C: Occluder<T>> Occluder<T> for (A
     #[cfg(feature = "closed-form")]
     fn hides_ball_from(&self, p: Vec3<T>, b: &Ball<T>) -> bool {
         self.0.hides_ball_from(p, b) || self.1.hides_ball_from(p, b) || self.2.hides_ball_from(p, b)
+    }
+    #[cfg(feature = "closed-form")]
+    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Vec3<T>, [T; 6])) -> bool {
+        self.0.event_quadrics(corner, edge, out)
+            && self.1.event_quadrics(corner, edge, out)
+            && self.2.event_quadrics(corner, edge, out)
     }
 }

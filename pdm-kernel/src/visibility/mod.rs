@@ -94,6 +94,20 @@ pub trait Occluder<T: Real> {
         false
     }
 
+    /// Outer-level events for an inner parallelogram (used by `boundary/` to place them into
+    /// the outer rule): for the inner patch's corner `corner` and its edge from `corner` to
+    /// `corner + edge`, passes to `out` quadrics F(p) = (p − apex)ᵀ M (p − apex), as the apex and
+    /// M's entries `[xx, yy, zz, xy, xz, yz]`, such that the visible part of the inner patch
+    /// seen from a point p changes its structure (this occluder's shadow boundary passing
+    /// through the corner, or becoming tangent to the edge) only where some F(p) = 0 (extra
+    /// quadrics are harmless, a missing one is a bug), and returns `true`; or returns `false`
+    /// (the default: the caller then samples across those events).
+    #[cfg(feature = "closed-form")]
+    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Vec3<T>, [T; 6])) -> bool {
+        let _ = (corner, edge, out);
+        false
+    }
+
     /// Conservative culling the other way: `true` only if every segment from `p` to a point of
     /// ball `b` is blocked (then nothing of b is visible from p). The default says "not sure"
     /// (`false`).

@@ -42,6 +42,33 @@ impl<T: Real> Occluder<T> for Sphere<T> {
         // θ + β < α ⇔ cos(θ + β) > cos α, with θ + β < π (θ > π/2 fails anyway).
         cos_theta > T::ZERO && cos_theta * cos_beta - sin_theta * sin_beta > cos_alpha * (T::ONE + margin) + margin
     }
+    /// The segment from p to the corner c touches the sphere where the line through them is
+    /// tangent to it: |w × v|² = R²|v|² with w = centre − c, v = p − c, i.e.
+    /// vᵀ((|w|² − R²) I − w wᵀ) v = 0 (the double cone of tangents from c). The shadow becomes
+    /// tangent to the edge line (c, d) where the plane through it and p is tangent to the
+    /// sphere: (v·(w × d))² = R²|d × v|², i.e. vᵀ(g gᵀ − R²(|d|² I − d dᵀ)) v = 0 with
+    /// g = w × d (the two tangent planes through the line).
+    #[cfg(feature = "closed-form")]
+    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Vec3<T>, [T; 6])) -> bool {
+        let w = self.center - corner;
+        let r2 = self.radius * self.radius;
+        let k = w.norm2() - r2;
+        out(corner, [k - w.x * w.x, k - w.y * w.y, k - w.z * w.z, -w.x * w.y, -w.x * w.z, -w.y * w.z]);
+        let (g, d) = (w.cross(edge), edge);
+        let dd = d.norm2();
+        out(
+            corner,
+            [
+                g.x * g.x - r2 * (dd - d.x * d.x),
+                g.y * g.y - r2 * (dd - d.y * d.y),
+                g.z * g.z - r2 * (dd - d.z * d.z),
+                g.x * g.y + r2 * d.x * d.y,
+                g.x * g.z + r2 * d.x * d.z,
+                g.y * g.z + r2 * d.y * d.z,
+            ],
+        );
+        true
+    }
     /// With w = q − p and m = c − p the segment meets the sphere iff its direction lies in the
     /// tangent cone ((m·w)² ≥ (|m|² − R²)|w|²), in front of p (m·w > 0), and it reaches the
     /// sphere (q inside, or the closest approach m·w/|w|² < 1, i.e. w·(q − c) > 0); p on the

@@ -500,3 +500,49 @@ fn quadrilateral_and_triangle_block_as_their_outlines() {
         assert!(check_line_breaks(&AnyOccluder::Quadrilateral(tri), 13) > 100);
     }
 }
+
+/// The sphere's event quadrics against their geometry, for random corners, edges and points:
+/// the corner quadric is |v|²(dist(centre, line(p, c))² − R²), the edge quadric
+/// |d × v|²(dist(centre, plane(edge line, p))² − R²) (v = p − c), so each has the sign of the
+/// distance minus the radius and vanishes exactly where the line or the plane is tangent.
+#[test]
+#[cfg(feature = "closed-form")]
+fn sphere_event_quadrics_vanish_where_the_tangents_are() {
+    let mut rng = Lcg(0x2545_f491_4f6c_dd1d);
+    let sphere = Sphere::outer(vec3(0.3, -0.2, 0.1), 0.8).unwrap();
+    let (centre, r) = (sphere.center, sphere.radius);
+    for _ in 0..2000 {
+        let (c, d, p) = (rng.vec(4.0), rng.vec(2.0), rng.vec(4.0));
+        let mut quadrics = [(Vec3::ZERO, [0.0; 6]); 2];
+        let mut n = 0;
+        assert!(sphere.event_quadrics(c, d, &mut |apex, m| {
+            quadrics[n] = (apex, m);
+            n += 1;
+        }));
+        assert_eq!(n, 2);
+        let value = |(apex, m): (Vec3<f64>, [f64; 6])| {
+            let v = p - apex;
+            let [xx, yy, zz, xy, xz, yz] = m;
+            v.x * (xx * v.x + xy * v.y + xz * v.z)
+                + v.y * (xy * v.x + yy * v.y + yz * v.z)
+                + v.z * (xz * v.x + yz * v.y + zz * v.z)
+        };
+        let v = p - c;
+        let w = centre - c;
+        let line_distance = w.cross(v).norm() / v.norm();
+        let expected_corner = v.norm2() * (line_distance * line_distance - r * r);
+        let normal = d.cross(v);
+        let plane_distance = normal.dot(w).abs() / normal.norm();
+        let expected_edge = normal.norm2() * (plane_distance * plane_distance - r * r);
+        let scale = |e: f64, a: f64| e.abs().max(a.abs()).max(1e-300);
+        let (corner, edge) = (value(quadrics[0]), value(quadrics[1]));
+        assert!(
+            (corner - expected_corner).abs() <= 1e-9 * scale(expected_corner, v.norm2() * w.norm2()),
+            "{corner} {expected_corner}"
+        );
+        assert!(
+            (edge - expected_edge).abs() <= 1e-9 * scale(expected_edge, normal.norm2() * w.norm2()),
+            "{edge} {expected_edge}"
+        );
+    }
+}

@@ -1,0 +1,262 @@
+//! Outer-level events: the curves on a flat outer patch where J(p) changes its structure,
+//! placed into the outer rule.
+//!
+//! With the inner integral exact for every p, what remains non-smooth is J itself: across an
+//! occluder's shadow it has a kink where the shadow boundary passes through a corner of b
+//! (the visible area changes like δ² on one side only) and a 3/2-power point where the
+//! boundary becomes tangent to an edge of b (a cap of the shadow, δ^{3/2}); across b's plane
+//! it has a kink (b starts facing p). On a parallelogram a and a parallelogram b these curves
+//! are conics in a's parameters: each occluder gives, per corner and edge of b, quadrics in p
+//! ([`Occluder::event_quadrics`]), and b's plane a line. The outer integral is then taken as
+//! nested line integrals, as the inner one is ("Visibility boundaries" in the references):
+//!
+//! * along s, breaks where a conic crosses one of a's t-edges (a quadratic in s) or becomes
+//!   tangent to the t-lines (its discriminant in t, a quadratic in s);
+//! * along each t-line, breaks at the conics' roots (quadratics in t);
+//!
+//! every piece integrated by the Gauss rule graded towards its break ends
+//! (`for_each_piece`, `graded`): the map x² turns δ^{3/2} and the square-root ends of a
+//! tangency into smooth functions, so the outer rule converges with the order instead of
+//! algebraically. Two conics crossing inside a is not a break: there J is the sum of the two
+//! curves' singular parts to leading order. Curves are not trimmed to the part where they
+//! are real events (the half of a corner's cone facing away from the occluder, a tangent
+//! plane whose touching point misses the edge segment): a break where J is smooth costs
+//! rule points, not accuracy.
+
+use super::*;
+
+/// Most event curves on one outer patch: a sphere gives two per corner of b and b's plane one,
+/// so two spheres fit.
+pub(crate) const MAX_EVENT_CURVES: usize = 20;
+
+/// Most breaks along one outer line (two per curve) or in s (six per curve), ends included.
+const MAX_T_BREAKS: usize = 2 * MAX_EVENT_CURVES + 2;
+const MAX_S_BREAKS: usize = 6 * MAX_EVENT_CURVES + 2;
+
+/// A conic in the outer patch's parameters, Q(t, s) = tt·t² + ts·t·s + ss·s² + t·t + s·s + c,
+/// as `[tt, ts, ss, t, s, c]`.
+type Conic<T> = [T; 6];
+
+/// The event curves of one (outer, inner) pair of parallelograms.
+pub(super) struct Events<T> {
+    conics: [Conic<T>; MAX_EVENT_CURVES],
+    n: usize,
+}
+
+impl<T: Real> Events<T> {
+    /// The events of outer a (affine map `outer`: p = o + t·e_t + s·e_s) against inner b (affine
+    /// map `inner` over the parameter rectangle `rect`) across `occluders`; `None` if an
+    /// occluder cannot give its quadrics or they overflow [`MAX_EVENT_CURVES`].
+    pub(super) fn new<O: Occluder<T> + ?Sized>(
+        outer: (Vec3<T>, Vec3<T>, Vec3<T>),
+        inner: (Vec3<T>, Vec3<T>, Vec3<T>),
+        rect: ParamRect<T>,
+        occluders: &O,
+    ) -> Option<Self> {
+        let (o, et, es) = outer;
+        let (bo, bt, bs) = inner;
+        let mut events = Self { conics: [[T::ZERO; 6]; MAX_EVENT_CURVES], n: 0 };
+        let mut overflow = false;
+        let corner = |t: T, s: T| bo + bt.scale(t) + bs.scale(s);
+        let corners =
+            [corner(rect.t0, rect.s0), corner(rect.t1, rect.s0), corner(rect.t1, rect.s1), corner(rect.t0, rect.s1)];
+        for k in 0..4 {
+            let (Some(&c), Some(&next)) = (corners.get(k), corners.get((k + 1) % 4)) else { return None };
+            let supported = event_quadrics(occluders, c, next - c, &mut |apex, m| {
+                // xᵀ M y for the symmetric M given by its entries.
+                let bil = |x: Vec3<T>, y: Vec3<T>| {
+                    let [xx, yy, zz, xy, xz, yz] = m;
+                    x.x * (xx * y.x + xy * y.y + xz * y.z)
+                        + x.y * (xy * y.x + yy * y.y + yz * y.z)
+                        + x.z * (xz * y.x + yz * y.y + zz * y.z)
+                };
+                let v0 = o - apex;
+                let conic = [
+                    bil(et, et),
+                    T::TWO * bil(et, es),
+                    bil(es, es),
+                    T::TWO * bil(v0, et),
+                    T::TWO * bil(v0, es),
+                    bil(v0, v0),
+                ];
+                overflow |= !events.push(conic);
+            });
+            if !supported {
+                return None;
+            }
+        }
+        // b's plane: b faces p only on its front side.
+        let nb = bt.cross(bs);
+        overflow |= !events.push([T::ZERO, T::ZERO, T::ZERO, nb.dot(et), nb.dot(es), nb.dot(o - bo)]);
+        if overflow {
+            return None;
+        }
+        Some(events)
+    }
+
+    fn push(&mut self, conic: Conic<T>) -> bool {
+        if conic.iter().any(|c| !c.is_finite()) {
+            return false;
+        }
+        match self.conics.get_mut(self.n) {
+            Some(slot) => {
+                *slot = conic;
+                self.n += 1;
+                true
+            }
+            None => false,
+        }
+    }
+
+    fn used(&self) -> &[Conic<T>] {
+        self.conics.get(..self.n).unwrap_or_default()
+    }
+
+    /// ∫∫ f(t, s) dt ds over `r` with the events placed into the rule (module docs); `f` is the
+    /// outer integrand at a's parameters (J times a's area element).
+    pub(super) fn integrate(
+        &self,
+        r: ParamRect<T>,
+        rule: &GaussRule<T>,
+        f: &mut dyn FnMut(T, T) -> Result<T, PdmError>,
+    ) -> Result<T, PdmError> {
+        let mut breaks = [T::ZERO; MAX_S_BREAKS];
+        let mut n = 0usize;
+        let mut add = |x: T| place(x, r.s0, r.s1, &mut breaks, &mut n);
+        add(r.s0);
+        for &[tt, ts, ss, t1, s1, c] in self.used() {
+            // A t-edge crossed: Q(t_edge, s) = 0.
+            for te in [r.t0, r.t1] {
+                roots_near_double(ss, ts * te + s1, (tt * te + t1) * te + c, &mut add);
+            }
+            // Tangent to the t-lines: the discriminant in t of Q(·, s).
+            let four = T::TWO * T::TWO;
+            roots_near_double(
+                ts * ts - four * tt * ss,
+                T::TWO * ts * t1 - four * tt * s1,
+                t1 * t1 - four * tt * c,
+                &mut add,
+            );
+        }
+        add(r.s1);
+        let used = breaks.get_mut(..n).unwrap_or_default();
+        sort(used);
+        let (start, end) = graded_ends(used, r.s0, r.s1);
+        let mut total = T::ZERO;
+        pieces(used, start, end, |lo, hi, grade_lo, grade_hi| {
+            let width = hi - lo;
+            for (xs, ws) in rule.points() {
+                let (u, du) = graded((xs + T::ONE) * T::HALF, grade_lo, grade_hi);
+                let s = lo + width * u;
+                total += ws * T::HALF * du * width * self.line(r, s, rule, f)?;
+            }
+            Ok(())
+        })?;
+        Ok(total)
+    }
+
+    /// ∫ f(t, s) dt over [r.t0, r.t1] at one s, with breaks at the conics' roots.
+    fn line(
+        &self,
+        r: ParamRect<T>,
+        s: T,
+        rule: &GaussRule<T>,
+        f: &mut dyn FnMut(T, T) -> Result<T, PdmError>,
+    ) -> Result<T, PdmError> {
+        let mut breaks = [T::ZERO; MAX_T_BREAKS];
+        let mut n = 0usize;
+        let mut add = |x: T| place(x, r.t0, r.t1, &mut breaks, &mut n);
+        add(r.t0);
+        for &[tt, ts, ss, t1, s1, c] in self.used() {
+            roots_near_double(tt, ts * s + t1, (ss * s + s1) * s + c, &mut add);
+        }
+        add(r.t1);
+        let used = breaks.get_mut(..n).unwrap_or_default();
+        sort(used);
+        let (start, end) = graded_ends(used, r.t0, r.t1);
+        let mut total = T::ZERO;
+        pieces(used, start, end, |lo, hi, grade_lo, grade_hi| {
+            let width = hi - lo;
+            for (xt, wt) in rule.points() {
+                let (u, du) = graded((xt + T::ONE) * T::HALF, grade_lo, grade_hi);
+                total += wt * T::HALF * du * width * f(lo + width * u, s)?;
+            }
+            Ok(())
+        })?;
+        Ok(total)
+    }
+}
+
+/// The `start` and `end` to pass to `for_each_piece` (which grades a piece's end only where
+/// it is not the interval's): moved off an end where an event lies on it (the sorted
+/// `breaks` hold that end twice), so that the rule is graded towards it too.
+fn graded_ends<T: Real>(breaks: &[T], lo: T, hi: T) -> (T, T) {
+    let width = hi - lo;
+    let at_lo = breaks.iter().filter(|&&x| x == lo).count() > 1;
+    let at_hi = breaks.iter().filter(|&&x| x == hi).count() > 1;
+    (if at_lo { lo - width } else { lo }, if at_hi { hi + width } else { hi })
+}
+
+/// Keeps a break x in [lo, hi] (ends included) while `breaks` has room; each curve adds at most
+/// six breaks in s and two along a line, which the buffers hold.
+fn place<T: Real>(x: T, lo: T, hi: T, breaks: &mut [T], n: &mut usize) {
+    if x.is_finite() && x >= lo && x <= hi {
+        if let Some(slot) = breaks.get_mut(*n) {
+            *slot = x;
+            *n += 1;
+        }
+    }
+}
+
+/// The real roots of a·x² + b·x + c, and the double root −b/(2a) also where rounding has made
+/// the discriminant slightly negative (a conic that is a pair of lines has a discriminant that
+/// is a perfect square: its double root is where the lines cross).
+fn roots_near_double<T: Real>(a: T, b: T, c: T, out: &mut dyn FnMut(T)) {
+    let four = T::TWO * T::TWO;
+    let disc = b * b - four * a * c;
+    let scale = b * b + (four * a * c).abs();
+    if disc < T::ZERO && -disc <= T::from_f64(64.0) * T::EPSILON * scale && a != T::ZERO {
+        out(-b / (T::TWO * a));
+        return;
+    }
+    crate::visibility::polynomial_roots(a, b, c, out);
+}
+
+/// [`Occluder::event_quadrics`] when the `closed-form` feature is on; `false` otherwise.
+#[inline]
+fn event_quadrics<T: Real, O: Occluder<T> + ?Sized>(
+    occluders: &O,
+    corner: Vec3<T>,
+    edge: Vec3<T>,
+    out: &mut dyn FnMut(Vec3<T>, [T; 6]),
+) -> bool {
+    #[cfg(feature = "closed-form")]
+    return occluders.event_quadrics(corner, edge, out);
+    #[cfg(not(feature = "closed-form"))]
+    {
+        let _ = (occluders, corner, edge, out);
+        false
+    }
+}
+
+/// Calls `f(lo, hi, graded_lo, graded_hi)` for the pieces of [start, end] between the sorted
+/// `breaks` (which include start and end), graded at every end that is a break inside
+/// (start, end). Unlike the inner rule's pieces, a piece next to a much narrower one is not cut
+/// geometrically towards it: the outer curves of one pair often nearly meet (every corner and
+/// edge of b gives one, and they pass close to each other), and those cuts multiplied the outer
+/// points several-fold (up to 60× on a whole face) for no measured gain in accuracy.
+fn pieces<T: Real>(
+    breaks: &[T],
+    start: T,
+    end: T,
+    mut f: impl FnMut(T, T, bool, bool) -> Result<(), PdmError>,
+) -> Result<(), PdmError> {
+    for w in breaks.windows(2) {
+        if let [lo, hi] = w {
+            if hi > lo {
+                f(*lo, *hi, *lo > start, *hi < end)?;
+            }
+        }
+    }
+    Ok(())
+}
