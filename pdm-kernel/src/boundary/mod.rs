@@ -34,10 +34,13 @@
 //! kernel_inner_visibility.rs`: 1.9e-9, 3.6e-13, 1.2e-16 at orders 8, 12, 16; ≤ 6e-11 over 45
 //! point/face/radius cases at order 24). What remains non-smooth is the **outer** integrand
 //! J(p), on curves of face a where a shadow boundary becomes tangent to an edge of b or passes
-//! through a corner; the outer rule samples across them (algebraic convergence), which patch
-//! grids (and the outer split in [`crate::pair`]) reduce. The outer rule does not place those
-//! curves: bracketing the count of inner singular points along outer t-lines converges along
-//! each line, but the outer s-level then meets curves parallel to the t-lines, at 10× the time.
+//! through a corner. Where a and b are both parallelograms and every occluder gives these
+//! curves ([`Occluder::event_quadrics`]: the sphere), they are conics in a's parameters and
+//! are placed into the outer rule the same way (`events.rs`): whole faces across a sphere then
+//! converge exponentially (cube faces against the independent reference: 1.3e-8 / 1.6e-11 at
+//! orders 8 / 12, `pdm-host/tests/outer_events.rs`). Elsewhere the outer rule samples across
+//! them (algebraic convergence), which patch grids (and the outer split in [`crate::pair`])
+//! reduce.
 //!
 //! Per outer point p the machinery runs only where it is needed: if no occluder meets the cone
 //! of segments from p to b's bounding ball ([`Occluder::may_block_between`] with p as a ball of
@@ -66,9 +69,9 @@
 //! spacing (a shadow sliver between two probes) is not seen; its contribution is then sampled
 //! by the rule as usual.
 //!
-//! Files: the pair level (outer cells, outer points, culling) here; `inner.rs` (J(p) for one
-//! outer point), `lines.rs` (one inner line in closed form), `breaks.rs` (bracketing and
-//! bisection).
+//! Files: the pair level (outer cells, outer points, culling) here; `events.rs` (the outer
+//! events of two parallelograms), `inner.rs` (J(p) for one outer point), `lines.rs` (one inner
+//! line in closed form), `breaks.rs` (bracketing and bisection).
 
 use crate::error::PdmError;
 use crate::gauss::GaussRule;

@@ -24,8 +24,9 @@
 //! - Other separate pairs use the PDM sum at `order`. With `boundaries` on, a pair that
 //!   straddles a back-face cut, that an occluder may cut, or whose patches are closer than
 //!   their size gets the visibility boundaries placed into the inner rule and the inner patch
-//!   refined towards each outer point (`boundary/`; the outer patch is also split
-//!   `OCCLUDED_OUTER_SPLIT`² when an occluder may cut); smooth, distant, unoccludable pairs
+//!   refined towards each outer point (`boundary/`; when an occluder may cut, the outer
+//!   events are placed into the outer rule for two parallelograms across spheres, and the
+//!   outer patch is split `OCCLUDED_OUTER_SPLIT`² otherwise); smooth, distant, unoccludable pairs
 //!   keep the plain sum. Without occluders the outer patch is, for a very near pair with one
 //!   flat patch, the curved one; otherwise the one with fewer points that see none of the
 //!   other, then the one whose points stay farther from the other's edges (`outer_is_b`).
@@ -69,11 +70,11 @@ pub(crate) use flat::*;
 pub(crate) use pieces::*;
 pub(crate) use route::*;
 
-/// Cells per side into which the outer patch of a pair that an occluder may cut is split.
-/// The inner integral is exponential in the order (closed-form boundaries), the outer one only
-/// algebraic in the cell size (kinks where a shadow boundary meets the inner patch's corners or
-/// edges), so finer outer cells at a lower order pay: on the paper's cube, 3 × 3 beats 2 × 2 at
-/// equal cost for every radius and grid tried (RESULTS.md, "Within 1e-6 in under a second").
+/// Cells per side into which the outer patch of a pair that an occluder may cut is split,
+/// where the outer events are not placed into the rule (`boundary/`: they are for two
+/// parallelograms across sphere occluders). There the outer integral is only algebraic in the
+/// cell size (kinks where a shadow boundary meets the inner patch's corners or edges), so finer
+/// outer cells at a lower order pay: 3 × 3 beat 2 × 2 at equal cost on the paper's cube.
 #[doc(hidden)]
 pub const OCCLUDED_OUTER_SPLIT: usize = 3;
 
@@ -124,10 +125,12 @@ impl PairSettings {
 ///   same sphere tilted: 1.6e-6 against the plate whole, 6.3e-8 cut 2 × 2) and worse for
 ///   single pairs (a sphere quarter against a disk quarter: 2.6e-4 at order 12; over the
 ///   whole sphere and disk such errors cancel to 1e-13). Finer grids reduce it;
-/// - across occluders (a shadow edge meeting the inner patch's corners and edges): about 1e-7
-///   to 1e-5 relative (a sphere inside a box, the floor's row to the other faces: 1.3e-6 at
-///   order 12, 1.2e-6 at 16; a tube between a small square and a large one: 2.1e-5 at 16,
-///   its shadow's boundaries bisected rather than solved); an occluder that cuts through the outer patch itself makes the
+/// - across occluders other than spheres, or with a curved patch (a shadow edge meeting the
+///   inner patch's corners and edges, sampled by the outer rule): about 1e-7 to 1e-5 relative
+///   (a tube between a small square and a large one: 2.1e-5 at 16, its shadow's boundaries
+///   bisected rather than solved). Two parallelograms across spheres have those curves placed
+///   into the outer rule and converge exponentially (whole cube faces around a sphere: 1.3e-8
+///   at order 8, 1.6e-11 at 12); an occluder that cuts through the outer patch itself makes the
 ///   outer integrand jump along the cut, and the outer rule converges only like 1/order (a
 ///   partition plate through two parallel rectangles, dividing both: 7.8e-4 at order 12,
 ///   5.1e-4 at 16; split the patches along the cut, or use the tolerance mode);
