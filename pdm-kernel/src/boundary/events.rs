@@ -15,7 +15,7 @@
 //! * along each t-line, breaks at the conics' roots (quadratics in t);
 //!
 //! every piece integrated by the Gauss rule graded towards its break ends
-//! (`for_each_piece`, `graded`): the map x² turns δ^{3/2} and the square-root ends of a
+//! (`pieces`, `graded`): the map x² turns δ^{3/2} and the square-root ends of a
 //! tangency into smooth functions, so the outer rule converges with the order instead of
 //! algebraically. Two conics crossing inside a is not a break: there J is the sum of the two
 //! curves' singular parts to leading order. Curves are not trimmed to the part where they
@@ -25,9 +25,16 @@
 
 use super::*;
 
-/// Most event curves on one outer patch: a sphere gives two per corner of b and b's plane one,
-/// so two spheres fit.
-pub(crate) const MAX_EVENT_CURVES: usize = 20;
+/// Most event curves on one outer patch: the occluder gives two per corner of b (a sphere:
+/// [`QUADRICS_PER_CORNER`]) and b's plane one.
+pub(crate) const MAX_EVENT_CURVES: usize = 4 * QUADRICS_PER_CORNER + 1;
+
+/// Most quadrics one corner may give: one occluder's (a sphere's tangent cone from the corner
+/// and its two tangent planes through the edge). Where more come, several occluders cast
+/// shadows on b, and where two shadows meet (one inside the other's edge, or touching) J
+/// changes structure on curves that are no occluder's quadrics: the events are declined and
+/// the outer rule samples across them as before.
+const QUADRICS_PER_CORNER: usize = 2;
 
 /// Most breaks along one outer line (two per curve) or in s (six per curve), ends included.
 const MAX_T_BREAKS: usize = 2 * MAX_EVENT_CURVES + 2;
@@ -46,7 +53,9 @@ pub(super) struct Events<T> {
 impl<T: Real> Events<T> {
     /// The events of outer a (affine map `outer`: p = o + t·e_t + s·e_s) against inner b (affine
     /// map `inner` over the parameter rectangle `rect`) across `occluders`; `None` if an
-    /// occluder cannot give its quadrics or they overflow [`MAX_EVENT_CURVES`].
+    /// occluder cannot give its quadrics, more than one occluder gives them
+    /// ([`QUADRICS_PER_CORNER`]), a coefficient is not finite, or b straddles a's plane (the part
+    /// of b in front of a then has an edge and corners that are not b's).
     pub(super) fn new<O: Occluder<T> + ?Sized>(
         outer: (Vec3<T>, Vec3<T>, Vec3<T>),
         inner: (Vec3<T>, Vec3<T>, Vec3<T>),
@@ -60,9 +69,22 @@ impl<T: Real> Events<T> {
         let corner = |t: T, s: T| bo + bt.scale(t) + bs.scale(s);
         let corners =
             [corner(rect.t0, rect.s0), corner(rect.t1, rect.s0), corner(rect.t1, rect.s1), corner(rect.t0, rect.s1)];
+        // b straddling a's plane: the visible part of b is clipped by it.
+        let na = et.cross(es);
+        let size = corners.iter().fold(T::ZERO, |m, &c| m.max((c - bo).norm())).max(et.norm()).max(es.norm());
+        let band = na.norm() * size * T::GEOMETRY_TOLERANCE;
+        let (front, behind) = corners.iter().fold((false, false), |(f, b), &c| {
+            let h = na.dot(c - o);
+            (f || h > band, b || h < -band)
+        });
+        if front && behind {
+            return None;
+        }
         for k in 0..4 {
             let (Some(&c), Some(&next)) = (corners.get(k), corners.get((k + 1) % 4)) else { return None };
-            let supported = event_quadrics(occluders, c, next - c, &mut |apex, m| {
+            let mut given = 0usize;
+            let supported = occluders.event_quadrics(c, next - c, &mut |apex, m| {
+                given += 1;
                 // xᵀ M y for the symmetric M given by its entries.
                 let bil = |x: Vec3<T>, y: Vec3<T>| {
                     let [xx, yy, zz, xy, xz, yz] = m;
@@ -81,7 +103,7 @@ impl<T: Real> Events<T> {
                 ];
                 overflow |= !events.push(conic);
             });
-            if !supported {
+            if !supported || given > QUADRICS_PER_CORNER {
                 return None;
             }
         }
@@ -94,10 +116,16 @@ impl<T: Real> Events<T> {
         Some(events)
     }
 
+    /// Keeps a conic scaled to its largest coefficient 1 (the roots do not change, and the
+    /// polynomials formed from it stay in range: a sphere's coefficients grow like the 6th
+    /// power of the scene's size, their discriminants like the 12th); `false` for a
+    /// non-finite conic or a full buffer.
     fn push(&mut self, conic: Conic<T>) -> bool {
         if conic.iter().any(|c| !c.is_finite()) {
             return false;
         }
+        let largest = conic.iter().fold(T::ZERO, |m, c| m.max(c.abs()));
+        let conic = if largest > T::ZERO { conic.map(|c| c / largest) } else { conic };
         match self.conics.get_mut(self.n) {
             Some(slot) => {
                 *slot = conic;
@@ -187,7 +215,7 @@ impl<T: Real> Events<T> {
     }
 }
 
-/// The `start` and `end` to pass to `for_each_piece` (which grades a piece's end only where
+/// The `start` and `end` to pass to `pieces` (which grades a piece's end only where
 /// it is not the interval's): moved off an end where an event lies on it (the sorted
 /// `breaks` hold that end twice), so that the rule is graded towards it too.
 fn graded_ends<T: Real>(breaks: &[T], lo: T, hi: T) -> (T, T) {
@@ -222,29 +250,13 @@ fn roots_near_double<T: Real>(a: T, b: T, c: T, out: &mut dyn FnMut(T)) {
     crate::visibility::polynomial_roots(a, b, c, out);
 }
 
-/// [`Occluder::event_quadrics`] when the `closed-form` feature is on; `false` otherwise.
-#[inline]
-fn event_quadrics<T: Real, O: Occluder<T> + ?Sized>(
-    occluders: &O,
-    corner: Vec3<T>,
-    edge: Vec3<T>,
-    out: &mut dyn FnMut(Vec3<T>, [T; 6]),
-) -> bool {
-    #[cfg(feature = "closed-form")]
-    return occluders.event_quadrics(corner, edge, out);
-    #[cfg(not(feature = "closed-form"))]
-    {
-        let _ = (occluders, corner, edge, out);
-        false
-    }
-}
-
 /// Calls `f(lo, hi, graded_lo, graded_hi)` for the pieces of [start, end] between the sorted
 /// `breaks` (which include start and end), graded at every end that is a break inside
 /// (start, end). Unlike the inner rule's pieces, a piece next to a much narrower one is not cut
 /// geometrically towards it: the outer curves of one pair often nearly meet (every corner and
 /// edge of b gives one, and they pass close to each other), and those cuts multiplied the outer
-/// points several-fold (up to 60× on a whole face) for no measured gain in accuracy.
+/// points several-fold (up to 60× on a whole face) for little accuracy (BENCHMARKS.md, "Outer
+/// events").
 fn pieces<T: Real>(
     breaks: &[T],
     start: T,

@@ -162,7 +162,8 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
     /// The singular points in s of the inner integral (closed-form mode): the lines' structure
     /// changes where a root of a polynomial crosses a t-edge (a quadratic in s) or two roots of
     /// one polynomial meet (its discriminant, a quartic in s); these candidates are found
-    /// exactly and kept where the structure differs on the two sides. Other changes (two
+    /// exactly and kept where the structure differs on the two sides, and a discriminant root
+    /// also where it does not (a branch point next to a piece; added while room is left). Other changes (two
     /// polynomials' roots crossing: a polygonal shadow's corner, two shadows meeting) are
     /// bracketed and bisected between them. Returns the nearest singular points just outside
     /// [s0, s1] (within a quarter of its width), towards which the end pieces are graded;
@@ -268,19 +269,29 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
         let mut kept = 0usize;
         let mut last = r.s0 - h;
         let mut outside: Outside<T> = (None, None);
+        let mut branch_points = [T::ZERO; MAX_BREAKS];
+        let mut nb = 0usize;
         for &(c, tag) in candidates {
             if c - last <= delta {
                 continue;
             }
             let changes = self.line_signature(p, np, r, c - delta) != self.line_signature(p, np, r, c + delta);
             if !changes && tag & BRANCH_POINT != 0 {
-                // Two roots of one polynomial meeting outside b's t-range: the structure does
-                // not change there, but a root that is inside on a neighbouring piece grows like
-                // √(s − c) from it, a branch point just beyond that piece's end. As a break it
-                // grades that piece towards it (`for_each_piece`); the piece it bounds on the
-                // other side is smooth.
+                // Two roots of one polynomial meeting where the structure does not change
+                // (outside b's t-range, or a polynomial that decides nothing there): a root
+                // that is inside on a neighbouring piece grows like √(s − c) from it, a branch
+                // point just beyond that piece's end. As a break it grades that piece towards
+                // it (`for_each_piece`); the piece it bounds on the other side is smooth. Kept
+                // apart and added last, where room is left: the breaks that change the
+                // structure come first.
                 if c > r.s0 + delta && c < r.s1 - delta {
-                    push(out, n, c)?;
+                    let repeated = branch_points.get(..nb).unwrap_or_default().iter().any(|&x| (x - c).abs() <= delta);
+                    if !repeated {
+                        if let Some(slot) = branch_points.get_mut(nb) {
+                            *slot = c;
+                            nb += 1;
+                        }
+                    }
                 } else if c <= r.s0 + delta {
                     outside.0 = Some(outside.0.map_or(c, |o: T| o.max(c)).min(r.s0 - delta));
                 } else if outside.1.is_none() {
@@ -319,6 +330,13 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
                 locate_changes(&|s: T| self.line_signature(p, np, r, s), from, hi, probes, out, n)?;
             }
             lo = next.unwrap_or(r.s1);
+        }
+        // The branch points, while one slot stays free for the caller's end point.
+        for &c in branch_points.get(..nb).unwrap_or_default() {
+            if *n + 1 >= MAX_BREAKS + 2 {
+                break;
+            }
+            push(out, n, c)?;
         }
         Ok(Some(outside))
     }

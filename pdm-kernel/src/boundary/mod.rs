@@ -34,8 +34,9 @@
 //! kernel_inner_visibility.rs`: 1.9e-9, 3.6e-13, 1.2e-16 at orders 8, 12, 16; ≤ 6e-11 over 45
 //! point/face/radius cases at order 24). What remains non-smooth is the **outer** integrand
 //! J(p), on curves of face a where a shadow boundary becomes tangent to an edge of b or passes
-//! through a corner. Where a and b are both parallelograms and every occluder gives these
-//! curves ([`Occluder::event_quadrics`]: the sphere), they are conics in a's parameters and
+//! through a corner. Where a and b are both parallelograms, b lies on one side of a's plane,
+//! and one occluder gives these curves ([`Occluder::event_quadrics`]: the sphere; with several,
+//! where two shadows meet is no occluder's curve), they are conics in a's parameters and
 //! are placed into the outer rule the same way (`events.rs`): whole faces across a sphere then
 //! converge exponentially (cube faces against the independent reference: 1.3e-8 / 1.6e-11 at
 //! orders 8 / 12, `pdm-host/tests/outer_events.rs`). Elsewhere the outer rule samples across

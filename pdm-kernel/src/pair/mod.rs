@@ -25,7 +25,7 @@
 //!   straddles a back-face cut, that an occluder may cut, or whose patches are closer than
 //!   their size gets the visibility boundaries placed into the inner rule and the inner patch
 //!   refined towards each outer point (`boundary/`; when an occluder may cut, the outer
-//!   events are placed into the outer rule for two parallelograms across spheres, and the
+//!   events are placed into the outer rule for two parallelograms across one sphere, and the
 //!   outer patch is split `OCCLUDED_OUTER_SPLIT`² otherwise); smooth, distant, unoccludable pairs
 //!   keep the plain sum. Without occluders the outer patch is, for a very near pair with one
 //!   flat patch, the curved one; otherwise the one with fewer points that see none of the
@@ -128,7 +128,7 @@ impl PairSettings {
 /// - across occluders other than spheres, or with a curved patch (a shadow edge meeting the
 ///   inner patch's corners and edges, sampled by the outer rule): about 1e-7 to 1e-5 relative
 ///   (a tube between a small square and a large one: 2.1e-5 at 16, its shadow's boundaries
-///   bisected rather than solved). Two parallelograms across spheres have those curves placed
+///   bisected rather than solved). Two parallelograms across one sphere have those curves placed
 ///   into the outer rule and converge exponentially (whole cube faces around a sphere: 1.3e-8
 ///   at order 8, 1.6e-11 at 12); an occluder that cuts through the outer patch itself makes the
 ///   outer integrand jump along the cut, and the outer rule converges only like 1/order (a
@@ -310,9 +310,11 @@ where
     }
 }
 
-/// A separate pair: the plain sum where the integrand is smooth, else the boundary path (with
-/// the outer patch split `OCCLUDED_OUTER_SPLIT`² where an occluder may cut: shadow edges
-/// crossing the inner patch make the outer integrand kink where they touch its edges).
+/// A separate pair: the plain sum where the integrand is smooth, else the boundary path. Where
+/// an occluder may cut, shadow edges crossing the inner patch make the outer integrand kink
+/// where they touch its edges: two parallelograms across one sphere get those curves placed
+/// into the outer rule (`boundary/`, outer events), other pairs the outer patch split
+/// `OCCLUDED_OUTER_SPLIT`².
 fn separate<T, SA, SB, O, const CAP: usize>(
     pair: &mut PairContext<'_, '_, T, SA, SB, O, CAP>,
     settings: PairSettings,
