@@ -15,7 +15,7 @@
 //! * along each t-line, breaks at the conics' roots (quadratics in t);
 //!
 //! every piece integrated by the Gauss rule graded towards its break ends
-//! (`pieces`, `graded`): the map x² turns δ^{3/2} and the square-root ends of a
+//! (`graded_sum`, `graded`): the map x² turns δ^{3/2} and the square-root ends of a
 //! tangency into smooth functions, so the outer rule converges with the order instead of
 //! algebraically. Two conics crossing inside a is not a break: there J is the sum of the two
 //! curves' singular parts to leading order. Curves are not trimmed to the part where they
@@ -167,20 +167,7 @@ impl<T: Real> Events<T> {
             );
         }
         add(r.s1);
-        let used = breaks.get_mut(..n).unwrap_or_default();
-        sort(used);
-        let (start, end) = graded_ends(used, r.s0, r.s1);
-        let mut total = T::ZERO;
-        pieces(used, start, end, |lo, hi, grade_lo, grade_hi| {
-            let width = hi - lo;
-            for (xs, ws) in rule.points() {
-                let (u, du) = graded((xs + T::ONE) * T::HALF, grade_lo, grade_hi);
-                let s = lo + width * u;
-                total += ws * T::HALF * du * width * self.line(r, s, rule, f)?;
-            }
-            Ok(())
-        })?;
-        Ok(total)
+        graded_sum(breaks.get_mut(..n).unwrap_or_default(), r.s0, r.s1, rule, &mut |s| self.line(r, s, rule, f))
     }
 
     /// ∫ f(t, s) dt over [r.t0, r.t1] at one s, with breaks at the conics' roots.
@@ -199,30 +186,8 @@ impl<T: Real> Events<T> {
             roots_near_double(tt, ts * s + t1, (ss * s + s1) * s + c, &mut add);
         }
         add(r.t1);
-        let used = breaks.get_mut(..n).unwrap_or_default();
-        sort(used);
-        let (start, end) = graded_ends(used, r.t0, r.t1);
-        let mut total = T::ZERO;
-        pieces(used, start, end, |lo, hi, grade_lo, grade_hi| {
-            let width = hi - lo;
-            for (xt, wt) in rule.points() {
-                let (u, du) = graded((xt + T::ONE) * T::HALF, grade_lo, grade_hi);
-                total += wt * T::HALF * du * width * f(lo + width * u, s)?;
-            }
-            Ok(())
-        })?;
-        Ok(total)
+        graded_sum(breaks.get_mut(..n).unwrap_or_default(), r.t0, r.t1, rule, &mut |t| f(t, s))
     }
-}
-
-/// The `start` and `end` to pass to `pieces` (which grades a piece's end only where
-/// it is not the interval's): moved off an end where an event lies on it (the sorted
-/// `breaks` hold that end twice), so that the rule is graded towards it too.
-fn graded_ends<T: Real>(breaks: &[T], lo: T, hi: T) -> (T, T) {
-    let width = hi - lo;
-    let at_lo = breaks.iter().filter(|&&x| x == lo).count() > 1;
-    let at_hi = breaks.iter().filter(|&&x| x == hi).count() > 1;
-    (if at_lo { lo - width } else { lo }, if at_hi { hi + width } else { hi })
 }
 
 /// Keeps a break x in [lo, hi] (ends included) while `breaks` has room; each curve adds at most
@@ -250,25 +215,35 @@ fn roots_near_double<T: Real>(a: T, b: T, c: T, out: &mut dyn FnMut(T)) {
     crate::visibility::polynomial_roots(a, b, c, out);
 }
 
-/// Calls `f(lo, hi, graded_lo, graded_hi)` for the pieces of [start, end] between the sorted
-/// `breaks` (which include start and end), graded at every end that is a break inside
-/// (start, end). Unlike the inner rule's pieces, a piece next to a much narrower one is not cut
-/// geometrically towards it: the outer curves of one pair often nearly meet (every corner and
-/// edge of b gives one, and they pass close to each other), and those cuts multiplied the outer
-/// points several-fold (up to 60× on a whole face) for little accuracy (BENCHMARKS.md, "Outer
-/// events").
-fn pieces<T: Real>(
-    breaks: &[T],
-    start: T,
-    end: T,
-    mut f: impl FnMut(T, T, bool, bool) -> Result<(), PdmError>,
-) -> Result<(), PdmError> {
+/// ∫ g over [lo, hi] by the rule on the pieces between the `breaks` (which hold lo and hi),
+/// each graded ([`graded`]) at every end that is a break inside (lo, hi) or an end that a break
+/// lies on too (held twice). Unlike the inner rule's pieces (`for_each_piece`), a piece next to
+/// a much narrower one is not cut geometrically towards it: the outer curves of one pair often
+/// nearly meet (every corner and edge of b gives one, and they pass close to each other), and
+/// those cuts multiplied the outer points several-fold (up to 60× on a whole face) for little
+/// accuracy (BENCHMARKS.md, "Outer events").
+fn graded_sum<T: Real>(
+    breaks: &mut [T],
+    lo: T,
+    hi: T,
+    rule: &GaussRule<T>,
+    g: &mut dyn FnMut(T) -> Result<T, PdmError>,
+) -> Result<T, PdmError> {
+    sort(breaks);
+    let at_lo = breaks.iter().filter(|&&x| x == lo).count() > 1;
+    let at_hi = breaks.iter().filter(|&&x| x == hi).count() > 1;
+    let mut total = T::ZERO;
     for w in breaks.windows(2) {
-        if let [lo, hi] = w {
-            if hi > lo {
-                f(*lo, *hi, *lo > start, *hi < end)?;
-            }
+        let &[a, b] = w else { continue };
+        if !(b > a) {
+            continue;
+        }
+        let (grade_a, grade_b) = (a > lo || at_lo, b < hi || at_hi);
+        let width = b - a;
+        for (x, wx) in rule.points() {
+            let (u, du) = graded((x + T::ONE) * T::HALF, grade_a, grade_b);
+            total += wx * T::HALF * du * width * g(a + width * u)?;
         }
     }
-    Ok(())
+    Ok(total)
 }

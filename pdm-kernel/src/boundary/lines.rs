@@ -171,10 +171,30 @@ pub(super) fn closed_form_line<T: Real>(
     candidates: &mut [(T, u64); MAX_CANDIDATES],
     line: &mut Line<T>,
 ) -> bool {
+    let roots = |&[a, b, c]: &[T; 3], out: &mut dyn FnMut(T)| {
+        crate::visibility::polynomial_roots(a, b, c, out);
+        true
+    };
+    line_from_roots(polys, roots, t0, t1, vis_at, candidates, line)
+}
+
+/// The visibility structure of the line t ∈ [t0, t1] from the roots of the functions `fs`
+/// (`roots` passes one function's roots and says whether it found them all): the roots inside
+/// (t0, t1), each tagged with its function, are the candidate switches of
+/// [`line_from_candidates`]. `false` if they overflow `candidates` or were not all found.
+fn line_from_roots<T: Real>(
+    fs: &[[T; 3]],
+    roots: impl Fn(&[T; 3], &mut dyn FnMut(T)) -> bool,
+    t0: T,
+    t1: T,
+    vis_at: &impl Fn(T) -> bool,
+    candidates: &mut [(T, u64); MAX_CANDIDATES],
+    line: &mut Line<T>,
+) -> bool {
     let mut n = 0usize;
     let mut overflow = false;
-    for (id, &[a, b, c]) in polys.iter().enumerate() {
-        crate::visibility::polynomial_roots(a, b, c, &mut |t| {
+    for (id, f) in fs.iter().enumerate() {
+        let complete = roots(f, &mut |t| {
             if t > t0 && t < t1 {
                 match candidates.get_mut(n) {
                     Some(slot) => {
@@ -185,6 +205,7 @@ pub(super) fn closed_form_line<T: Real>(
                 }
             }
         });
+        overflow |= !complete;
     }
     !overflow && line_from_candidates(candidates.get_mut(..n).unwrap_or_default(), t0, t1, vis_at, line)
 }
@@ -257,19 +278,8 @@ pub(super) fn trigonometric_line<T: Real>(
     candidates: &mut [(T, u64); MAX_CANDIDATES],
     line: &mut Line<T>,
 ) -> bool {
-    let mut n = 0usize;
-    let mut overflow = false;
-    for (id, &f) in fs.iter().enumerate() {
-        let complete = trigonometric_roots(f, t0, t1, &mut |t| match candidates.get_mut(n) {
-            Some(slot) => {
-                *slot = (t, id as u64 + 1);
-                n += 1;
-            }
-            None => overflow = true,
-        });
-        overflow |= !complete;
-    }
-    !overflow && line_from_candidates(candidates.get_mut(..n).unwrap_or_default(), t0, t1, vis_at, line)
+    let roots = |&f: &[T; 3], out: &mut dyn FnMut(T)| trigonometric_roots(f, t0, t1, &mut |t| out(t));
+    line_from_roots(fs, roots, t0, t1, vis_at, candidates, line)
 }
 
 /// The roots in (t0, t1) of a + b·cos t + c·sin t: with ρ = √(b² + c²) and δ = atan2(c, b) it

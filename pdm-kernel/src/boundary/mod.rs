@@ -228,7 +228,6 @@ where
             &inner,
             inner_samples,
             &inner_bounds,
-            order,
         )? {
             let value = crate::bounds::finite(total * T::FRAC_1_PI)?;
             return Ok((value, count.get()));
@@ -251,7 +250,6 @@ where
 /// into the outer rule (`events.rs`); `None` where the occluders give no events.
 #[cfg(feature = "closed-form")]
 #[inline(never)]
-#[allow(clippy::too_many_arguments)]
 fn events_sum<T, SA, SB, O, const CB: usize>(
     a: &Patch<'_, T, SA>,
     outer_map: (Vec3<T>, Vec3<T>, Vec3<T>),
@@ -260,7 +258,6 @@ fn events_sum<T, SA, SB, O, const CB: usize>(
     inner: &Inner<'_, T, SB, O>,
     inner_samples: &PatchSamples<T, CB>,
     inner_bounds: &Ball<T>,
-    order: usize,
 ) -> Result<Option<T>, PdmError>
 where
     T: Real,
@@ -274,7 +271,6 @@ where
         Events::new(outer_map, inner_map, inner.r, &())
     };
     let Some(events) = events else { return Ok(None) };
-    let rule = GaussRule::<T>::new(order)?;
     let surface = a.surface();
     let mut f = |t: T, s: T| -> Result<T, PdmError> {
         let (p, n) = surface.point_and_normal(t, s);
@@ -286,7 +282,7 @@ where
     };
     let mut total = T::ZERO;
     for cell in cells {
-        total += events.integrate(*cell, &rule, &mut f)?;
+        total += events.integrate(*cell, &inner.rule, &mut f)?;
     }
     Ok(Some(total))
 }
