@@ -109,7 +109,7 @@ pub use substructure::{
     capacity_for, surface_exchange, surface_form_factor, with_capacity, Method, WithCapacity, CAPACITIES,
 };
 pub use surface::{
-    AutoNormal, BezierPatch, Cone, Cylinder, Disk, Flipped, Frame, Parallelogram, ParamRect, ParametricMap,
+    AutoNormal, BezierPatch, Cone, Cylinder, Disk, Flipped, Frame, Parallelogram, ParamRect, ParametricMap, Quadric,
     Quadrilateral, Side, Sphere, Surface,
 };
 pub use vec3::{vec3, Vec3};

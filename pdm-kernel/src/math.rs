@@ -31,6 +31,10 @@ pub(crate) mod f64m {
         libm::cos(x)
     }
     #[inline(always)]
+    pub(crate) fn sin_cos(x: f64) -> (f64, f64) {
+        libm::sincos(x)
+    }
+    #[inline(always)]
     pub(crate) fn atan2(y: f64, x: f64) -> f64 {
         libm::atan2(y, x)
     }
@@ -64,6 +68,10 @@ pub(crate) mod f32m {
     #[inline(always)]
     pub(crate) fn cos(x: f32) -> f32 {
         libm::cosf(x)
+    }
+    #[inline(always)]
+    pub(crate) fn sin_cos(x: f32) -> (f32, f32) {
+        libm::sincosf(x)
     }
     #[inline(always)]
     pub(crate) fn atan2(y: f32, x: f32) -> f32 {
@@ -107,6 +115,10 @@ pub(crate) mod f32m {
     #[inline(always)]
     pub(crate) fn cos(x: f32) -> f32 {
         F32Ext::cos(x)
+    }
+    #[inline(always)]
+    pub(crate) fn sin_cos(x: f32) -> (f32, f32) {
+        (F32Ext::sin(x), F32Ext::cos(x))
     }
     #[inline(always)]
     pub(crate) fn atan2(y: f32, x: f32) -> f32 {

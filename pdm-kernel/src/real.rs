@@ -81,6 +81,8 @@ pub trait Real:
     fn sin(self) -> Self;
     /// Cosine (through the math backend).
     fn cos(self) -> Self;
+    /// Sine and cosine together (one argument reduction with libm).
+    fn sin_cos(self) -> (Self, Self);
     /// Four-quadrant arctangent of `self / x` (through the math backend).
     fn atan2(self, x: Self) -> Self;
     /// Arctangent (through the math backend).
@@ -138,6 +140,10 @@ macro_rules! impl_real {
             #[inline(always)]
             fn cos(self) -> Self {
                 math::$math::cos(self)
+            }
+            #[inline(always)]
+            fn sin_cos(self) -> (Self, Self) {
+                math::$math::sin_cos(self)
             }
             #[inline(always)]
             fn atan2(self, x: Self) -> Self {

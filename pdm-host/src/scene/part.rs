@@ -7,7 +7,7 @@
 //! These occluders have no closed-form visibility along lines (`line_polynomials` answers
 //! "not known"): the kernel's occluded paths bracket and bisect their edges instead.
 
-use pdm_kernel::{AnyOccluder, Ball, Occluder, Real, Vec3};
+use pdm_kernel::{AnyOccluder, Ball, Occluder, Quadric, Real, Vec3};
 
 use super::shape::{Geom, Rect};
 
@@ -206,7 +206,7 @@ impl<T: Real> Occluder<T> for SceneOccluder<T> {
             Self::Part(_) => false,
         }
     }
-    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Vec3<T>, [T; 6])) -> bool {
+    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
         match self {
             Self::Whole(o) => o.event_quadrics(corner, edge, out),
             Self::Part(_) => false,

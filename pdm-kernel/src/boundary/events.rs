@@ -24,6 +24,7 @@
 //! rule points, not accuracy.
 
 use super::*;
+use crate::visibility::Quadric;
 
 /// Most event curves on one outer patch: the occluder gives two per corner of b (a sphere:
 /// [`QUADRICS_PER_CORNER`]) and b's plane one.
@@ -36,17 +37,42 @@ pub(crate) const MAX_EVENT_CURVES: usize = 4 * QUADRICS_PER_CORNER + 1;
 /// the outer rule samples across them as before.
 const QUADRICS_PER_CORNER: usize = 2;
 
-/// Most breaks along one outer line (two per curve) or in s (six per curve), ends included.
+/// Most breaks along one outer line (two per curve) or in s (six per curve, four more at the
+/// ends of a guarded curve), ends included.
 const MAX_T_BREAKS: usize = 2 * MAX_EVENT_CURVES + 2;
-const MAX_S_BREAKS: usize = 6 * MAX_EVENT_CURVES + 2;
+const MAX_S_BREAKS: usize = 10 * MAX_EVENT_CURVES + 2;
 
 /// A conic in the outer patch's parameters, Q(t, s) = tt·t² + ts·t·s + ss·s² + t·t + s·s + c,
 /// as `[tt, ts, ss, t, s, c]`.
 type Conic<T> = [T; 6];
 
-/// The event curves of one (outer, inner) pair of parallelograms.
+/// A line in the outer patch's parameters, L(t, s) = a·t + b·s + c, as `[a, b, c]`.
+type Line2<T> = [T; 3];
+
+/// One event curve: Q = 0 where the guard (L₀·L₁ ≥ 0, if any) holds.
+#[derive(Clone, Copy)]
+struct Curve<T> {
+    conic: Conic<T>,
+    guard: Option<[Line2<T>; 2]>,
+}
+
+impl<T: Real> Curve<T> {
+    /// Whether (t, s) lies where the curve is an event, with a margin of rounding (a point
+    /// let in wrongly costs a break, one kept out wrongly its accuracy).
+    fn holds(&self, t: T, s: T) -> bool {
+        self.guard.is_none_or(|lines| {
+            let [l0, l1] = lines.map(|[a, b, c]| {
+                let margin = T::from_f64(64.0) * T::EPSILON * ((a * t).abs() + (b * s).abs() + c.abs());
+                (a * t + b * s + c, margin)
+            });
+            l0.0 * l1.0 >= T::ZERO || l0.0.abs() <= l0.1 || l1.0.abs() <= l1.1
+        })
+    }
+}
+
+/// The event curves of one (outer, inner) pair.
 pub(super) struct Events<T> {
-    conics: [Conic<T>; MAX_EVENT_CURVES],
+    curves: [Curve<T>; MAX_EVENT_CURVES],
     n: usize,
 }
 
@@ -64,7 +90,7 @@ impl<T: Real> Events<T> {
     ) -> Option<Self> {
         let (o, et, es) = outer;
         let (bo, bt, bs) = inner;
-        let mut events = Self { conics: [[T::ZERO; 6]; MAX_EVENT_CURVES], n: 0 };
+        let mut events = Self { curves: [Curve { conic: [T::ZERO; 6], guard: None }; MAX_EVENT_CURVES], n: 0 };
         let mut overflow = false;
         let corner = |t: T, s: T| bo + bt.scale(t) + bs.scale(s);
         let corners =
@@ -83,25 +109,9 @@ impl<T: Real> Events<T> {
         for k in 0..4 {
             let (Some(&c), Some(&next)) = (corners.get(k), corners.get((k + 1) % 4)) else { return None };
             let mut given = 0usize;
-            let supported = occluders.event_quadrics(c, next - c, &mut |apex, m| {
+            let supported = occluders.event_quadrics(c, next - c, &mut |q| {
                 given += 1;
-                // xᵀ M y for the symmetric M given by its entries.
-                let bil = |x: Vec3<T>, y: Vec3<T>| {
-                    let [xx, yy, zz, xy, xz, yz] = m;
-                    x.x * (xx * y.x + xy * y.y + xz * y.z)
-                        + x.y * (xy * y.x + yy * y.y + yz * y.z)
-                        + x.z * (xz * y.x + yz * y.y + zz * y.z)
-                };
-                let v0 = o - apex;
-                let conic = [
-                    bil(et, et),
-                    T::TWO * bil(et, es),
-                    bil(es, es),
-                    T::TWO * bil(v0, et),
-                    T::TWO * bil(v0, es),
-                    bil(v0, v0),
-                ];
-                overflow |= !events.push(conic);
+                overflow |= !events.push_quadric(outer, q);
             });
             if !supported || given > QUADRICS_PER_CORNER {
                 return None;
@@ -109,26 +119,66 @@ impl<T: Real> Events<T> {
         }
         // b's plane: b faces p only on its front side.
         let nb = bt.cross(bs);
-        overflow |= !events.push([T::ZERO, T::ZERO, T::ZERO, nb.dot(et), nb.dot(es), nb.dot(o - bo)]);
+        overflow |= !events.push([T::ZERO, T::ZERO, T::ZERO, nb.dot(et), nb.dot(es), nb.dot(o - bo)], None);
         if overflow {
             return None;
         }
         Some(events)
     }
 
+    /// The events of outer a (affine map `outer`) against a curved inner patch (`surface` over
+    /// `rect`, inside the ball `bounds`) that no occluder cuts: the curves the surface gives
+    /// ([`Surface::event_quadrics`]). `None` if it gives none, they overflow the buffer, a
+    /// coefficient is not finite, or `bounds` reaches a's plane (a's facing test would then
+    /// cut b along a curve of its own).
+    pub(super) fn curved<S: Surface<T> + ?Sized>(
+        outer: (Vec3<T>, Vec3<T>, Vec3<T>),
+        surface: &S,
+        rect: ParamRect<T>,
+        bounds: &Ball<T>,
+    ) -> Option<Self> {
+        let (o, et, es) = outer;
+        let na = et.cross(es);
+        let height = na.dot(bounds.center - o) / na.norm();
+        if !(height.abs() > bounds.radius * (T::ONE + T::GEOMETRY_TOLERANCE)) {
+            return None;
+        }
+        let mut events = Self { curves: [Curve { conic: [T::ZERO; 6], guard: None }; MAX_EVENT_CURVES], n: 0 };
+        let mut overflow = false;
+        let supported = surface.event_quadrics(rect, &mut |q| overflow |= !events.push_quadric(outer, q));
+        (supported && !overflow && events.n > 0).then_some(events)
+    }
+
+    /// Keeps the quadric `q` restricted to a (affine map `outer`): with p = o + t·e_t + s·e_s and
+    /// v₀ = o − origin, F = (v₀ + t·e_t + s·e_s)ᵀ M (…) + g·(…) + c, a conic in (t, s), and each
+    /// guard g·v a line.
+    fn push_quadric(&mut self, outer: (Vec3<T>, Vec3<T>, Vec3<T>), q: Quadric<T>) -> bool {
+        let (o, et, es) = outer;
+        let v0 = o - q.origin;
+        let conic = [
+            q.bilinear(et, et),
+            T::TWO * q.bilinear(et, es),
+            q.bilinear(es, es),
+            T::TWO * q.bilinear(v0, et) + q.g.dot(et),
+            T::TWO * q.bilinear(v0, es) + q.g.dot(es),
+            q.bilinear(v0, v0) + q.g.dot(v0) + q.c,
+        ];
+        let guard = q.guard.map(|gs| gs.map(|g| scaled([g.dot(et), g.dot(es), g.dot(v0)])));
+        self.push(conic, guard)
+    }
+
     /// Keeps a conic scaled to its largest coefficient 1 (the roots do not change, and the
     /// polynomials formed from it stay in range: a sphere's coefficients grow like the 6th
     /// power of the scene's size, their discriminants like the 12th); `false` for a
-    /// non-finite conic or a full buffer.
-    fn push(&mut self, conic: Conic<T>) -> bool {
-        if conic.iter().any(|c| !c.is_finite()) {
+    /// non-finite conic or guard, or a full buffer.
+    fn push(&mut self, conic: Conic<T>, guard: Option<[Line2<T>; 2]>) -> bool {
+        let finite = |c: &[T]| c.iter().all(|c| c.is_finite());
+        if !finite(&conic) || guard.is_some_and(|[l0, l1]| !finite(&l0) || !finite(&l1)) {
             return false;
         }
-        let largest = conic.iter().fold(T::ZERO, |m, c| m.max(c.abs()));
-        let conic = if largest > T::ZERO { conic.map(|c| c / largest) } else { conic };
-        match self.conics.get_mut(self.n) {
+        match self.curves.get_mut(self.n) {
             Some(slot) => {
-                *slot = conic;
+                *slot = Curve { conic: scaled(conic), guard };
                 self.n += 1;
                 true
             }
@@ -136,8 +186,8 @@ impl<T: Real> Events<T> {
         }
     }
 
-    fn used(&self) -> &[Conic<T>] {
-        self.conics.get(..self.n).unwrap_or_default()
+    fn used(&self) -> &[Curve<T>] {
+        self.curves.get(..self.n).unwrap_or_default()
     }
 
     /// ∫∫ f(t, s) dt ds over `r` with the events placed into the rule (module docs); `f` is the
@@ -152,19 +202,61 @@ impl<T: Real> Events<T> {
         let mut n = 0usize;
         let mut add = |x: T| place(x, r.s0, r.s1, &mut breaks, &mut n);
         add(r.s0);
-        for &[tt, ts, ss, t1, s1, c] in self.used() {
+        for curve in self.used() {
+            let [tt, ts, ss, t1, s1, c] = curve.conic;
             // A t-edge crossed: Q(t_edge, s) = 0.
             for te in [r.t0, r.t1] {
-                roots_near_double(ss, ts * te + s1, (tt * te + t1) * te + c, &mut add);
+                roots_near_double(ss, ts * te + s1, (tt * te + t1) * te + c, &mut |s| {
+                    if curve.holds(te, s) {
+                        add(s);
+                    }
+                });
             }
-            // Tangent to the t-lines: the discriminant in t of Q(·, s).
+            // Tangent to the t-lines: the discriminant in t of Q(·, s), at t = −(ts·s + t)/(2·tt).
             let four = T::TWO * T::TWO;
             roots_near_double(
                 ts * ts - four * tt * ss,
                 T::TWO * ts * t1 - four * tt * s1,
                 t1 * t1 - four * tt * c,
-                &mut add,
+                &mut |s| {
+                    if tt == T::ZERO || curve.holds(-(ts * s + t1) / (T::TWO * tt), s) {
+                        add(s);
+                    }
+                },
             );
+            // The ends of a guarded curve: Q = 0 on a guard line.
+            for [a, b, lc] in curve.guard.into_iter().flatten() {
+                if a == T::ZERO && b == T::ZERO {
+                    // A guard plane parallel to a: the guard is constant on it.
+                } else if a.abs() >= b.abs() {
+                    // t = −(b·s + lc)/a = k·s + m.
+                    let (k, m) = (-b / a, -lc / a);
+                    roots_near_double(
+                        tt * k * k + ts * k + ss,
+                        T::TWO * tt * k * m + ts * m + t1 * k + s1,
+                        tt * m * m + t1 * m + c,
+                        &mut |s| {
+                            let t = k * s + m;
+                            if t >= r.t0 && t <= r.t1 {
+                                add(s);
+                            }
+                        },
+                    );
+                } else {
+                    // s = −(a·t + lc)/b = k·t + m.
+                    let (k, m) = (-a / b, -lc / b);
+                    roots_near_double(
+                        tt + ts * k + ss * k * k,
+                        ts * m + T::TWO * ss * k * m + t1 + s1 * k,
+                        ss * m * m + s1 * m + c,
+                        &mut |t| {
+                            if t >= r.t0 && t <= r.t1 {
+                                add(k * t + m);
+                            }
+                        },
+                    );
+                }
+            }
         }
         add(r.s1);
         graded_sum(breaks.get_mut(..n).unwrap_or_default(), r.s0, r.s1, rule, &mut |s| self.line(r, s, rule, f))
@@ -182,11 +274,26 @@ impl<T: Real> Events<T> {
         let mut n = 0usize;
         let mut add = |x: T| place(x, r.t0, r.t1, &mut breaks, &mut n);
         add(r.t0);
-        for &[tt, ts, ss, t1, s1, c] in self.used() {
-            roots_near_double(tt, ts * s + t1, (ss * s + s1) * s + c, &mut add);
+        for curve in self.used() {
+            let [tt, ts, ss, t1, s1, c] = curve.conic;
+            roots_near_double(tt, ts * s + t1, (ss * s + s1) * s + c, &mut |t| {
+                if curve.holds(t, s) {
+                    add(t);
+                }
+            });
         }
         add(r.t1);
         graded_sum(breaks.get_mut(..n).unwrap_or_default(), r.t0, r.t1, rule, &mut |t| f(t, s))
+    }
+}
+
+/// The coefficients scaled to the largest 1 (unchanged if all are zero).
+fn scaled<const N: usize, T: Real>(c: [T; N]) -> [T; N] {
+    let largest = c.iter().fold(T::ZERO, |m, c| m.max(c.abs()));
+    if largest > T::ZERO {
+        c.map(|c| c / largest)
+    } else {
+        c
     }
 }
 

@@ -341,6 +341,73 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
         Ok(Some(outside))
     }
 
+    /// The s-breaks of a curved b whose facing tests are trigonometric in both parameters
+    /// ([`Surface::facing_across_s`]): for each test f = a(s) + b(s)·cos t + c(s)·sin t, where
+    /// its zero set crosses a t-edge (f(t_edge, s) = 0, first-degree in s) and, where a and b
+    /// do not depend on s, where it is tangent to the t-lines (b² + c(s)² = a², i.e.
+    /// c(s) = ±√(a² − b²)), all solved by [`trigonometric_roots`]. Roots just outside [s0, s1]
+    /// (within a quarter of its width) are returned as the nearest singular points beyond its
+    /// ends; `None` (nothing pushed) where the surface has no such form or a root cannot be
+    /// found (the caller probes the edges instead).
+    #[cfg(feature = "closed-form")]
+    pub(super) fn trigonometric_events(
+        &self,
+        p: Vec3<T>,
+        np: Vec3<T>,
+        r: ParamRect<T>,
+        out: &mut [T; MAX_BREAKS + 2],
+        n: &mut usize,
+    ) -> Result<Option<Outside<T>>, PdmError> {
+        let Some(tests) = self.surface.facing_across_s(p, np) else { return Ok(None) };
+        let reach = (r.s1 - r.s0) * T::HALF * T::HALF;
+        let (lo, hi) = (r.s0 - reach, r.s1 + reach);
+        let mut roots = [T::ZERO; MAX_BREAKS];
+        let mut nr = 0usize;
+        let full = core::cell::Cell::new(false);
+        let mut add = |s: T| match roots.get_mut(nr) {
+            Some(slot) => {
+                *slot = s;
+                nr += 1;
+            }
+            None => full.set(true),
+        };
+        let mut ok = true;
+        for [a, b, c] in tests {
+            for te in [r.t0, r.t1] {
+                let (st, ct) = te.sin_cos();
+                let f = [a[0] + b[0] * ct + c[0] * st, a[1] + b[1] * ct + c[1] * st, a[2] + b[2] * ct + c[2] * st];
+                ok &= trigonometric_roots(f, lo, hi, &mut add);
+            }
+            if a[1] == T::ZERO && a[2] == T::ZERO && b[1] == T::ZERO && b[2] == T::ZERO {
+                let k2 = a[0] * a[0] - b[0] * b[0];
+                if k2 >= T::ZERO {
+                    let k = k2.sqrt();
+                    for sign in [T::ONE, -T::ONE] {
+                        ok &= trigonometric_roots([c[0] - sign * k, c[1], c[2]], lo, hi, &mut add);
+                    }
+                }
+            } else {
+                ok = false;
+            }
+        }
+        if !ok || full.get() {
+            return Ok(None);
+        }
+        let mut outside: Outside<T> = (None, None);
+        for &x in roots.get(..nr).unwrap_or_default() {
+            if x <= r.s0 {
+                outside.0 = Some(outside.0.map_or(x, |o: T| o.max(x)));
+            } else if x >= r.s1 {
+                outside.1 = Some(outside.1.map_or(x, |o: T| o.min(x)));
+            } else if *n + 1 < MAX_BREAKS + 2 {
+                push(out, n, x)?;
+            } else {
+                return Err(PdmError::CapacityExceeded { needed: *n + 2, capacity: MAX_BREAKS + 2 });
+            }
+        }
+        Ok(Some(outside))
+    }
+
     /// J(p) over the whole of a flat b (closed-form mode) with nothing between p and b, by the
     /// point-to-polygon (Lambert) form: the visible part of b is the polygon P = b ∩ {q : n̂_p·(q − p) > 0}
     /// (the other facing test is constant on a flat b), and with its vertices v_k seen from p,
@@ -501,6 +568,8 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
         let mut outside = (None, None);
         let in_closed_form = match self.affine {
             Some(_) => self.closed_form_events(p, np, r, &mut s_breaks, &mut ns)?,
+            #[cfg(feature = "closed-form")]
+            None if self.trigonometric => self.trigonometric_events(p, np, r, &mut s_breaks, &mut ns)?,
             None => None,
         };
         if let Some(o) = in_closed_form {

@@ -219,19 +219,10 @@ where
     // cut into cells, each no closer to b than its own radius (`outer_cells`).
     let (cells, n_cells) = outer_cells(a, b, &inner)?;
     #[cfg(feature = "closed-form")]
-    if let (Some(outer_map), Some(inner_map)) = (a.surface().affine_map(), inner.affine) {
-        if let Some(total) = events_sum(
-            a,
-            outer_map,
-            inner_map,
-            cells.get(..n_cells).unwrap_or_default(),
-            &inner,
-            inner_samples,
-            &inner_bounds,
-        )? {
-            let value = crate::bounds::finite(total * T::FRAC_1_PI)?;
-            return Ok((value, count.get()));
-        }
+    if let Some(total) = events_sum(a, cells.get(..n_cells).unwrap_or_default(), &inner, inner_samples, &inner_bounds)?
+    {
+        let value = crate::bounds::finite(total * T::FRAC_1_PI)?;
+        return Ok((value, count.get()));
     }
     let mut total = T::ZERO;
     if n_cells > 1 {
@@ -246,14 +237,12 @@ where
     Ok((value, count.get()))
 }
 
-/// The outer integral over the cells of a flat a against a flat b with the events placed
-/// into the outer rule (`events.rs`); `None` where the occluders give no events.
+/// The outer integral over the cells of a flat a with the events placed into the outer rule
+/// (`events.rs`); `None` where there are none to place ([`pair_events`]).
 #[cfg(feature = "closed-form")]
 #[inline(never)]
 fn events_sum<T, SA, SB, O, const CB: usize>(
     a: &Patch<'_, T, SA>,
-    outer_map: (Vec3<T>, Vec3<T>, Vec3<T>),
-    inner_map: (Vec3<T>, Vec3<T>, Vec3<T>),
     cells: &[ParamRect<T>],
     inner: &Inner<'_, T, SB, O>,
     inner_samples: &PatchSamples<T, CB>,
@@ -265,12 +254,18 @@ where
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
-    let events = if inner.use_occluders {
-        Events::new(outer_map, inner_map, inner.r, inner.occluders)
-    } else {
-        Events::new(outer_map, inner_map, inner.r, &())
+    let Some(outer_map) = a.surface().affine_map() else { return Ok(None) };
+    let Some(events) = pair_events(
+        outer_map,
+        inner.surface,
+        inner.r,
+        inner.affine,
+        inner.use_occluders,
+        inner.occluders,
+        inner_bounds,
+    ) else {
+        return Ok(None);
     };
-    let Some(events) = events else { return Ok(None) };
     let surface = a.surface();
     let mut f = |t: T, s: T| -> Result<T, PdmError> {
         let (p, n) = surface.point_and_normal(t, s);
@@ -287,9 +282,37 @@ where
     Ok(Some(total))
 }
 
+/// The outer events of a flat outer patch (affine map `outer_map`) against the inner patch
+/// (`surface` over `r`, inside `bounds`; `affine` its map where its lines are in closed form):
+/// a flat inner patch across the occluders when `use_occluders` (else across none), a curved
+/// one only where no occluder cuts.
+#[cfg(feature = "closed-form")]
+fn pair_events<T, SB, O>(
+    outer_map: (Vec3<T>, Vec3<T>, Vec3<T>),
+    surface: &SB,
+    r: ParamRect<T>,
+    affine: Option<(Vec3<T>, Vec3<T>, Vec3<T>)>,
+    use_occluders: bool,
+    occluders: &O,
+    bounds: &Ball<T>,
+) -> Option<Events<T>>
+where
+    T: Real,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
+    match (affine, use_occluders) {
+        (Some(inner_map), true) => Events::new(outer_map, inner_map, r, occluders),
+        (Some(inner_map), false) => Events::new(outer_map, inner_map, r, &()),
+        (None, false) => Events::curved(outer_map, surface, r, bounds),
+        (None, true) => None,
+    }
+}
+
 /// Whether [`boundary_sum`] places the outer events into the rule for this pair with `outer`
-/// outside (both flat, every occluder giving its quadrics): the outer patch is then not
-/// split into cells for its kinks.
+/// outside ([`pair_events`]: a flat outer patch, and a flat inner one whose occluders give
+/// their quadrics or a curved one that gives its own): the outer patch is then not split into
+/// cells for its kinks, and its convergence in the order is exponential.
 #[cfg(feature = "closed-form")]
 pub(crate) fn outer_events_apply<T, SA, SB, O>(
     outer: &Patch<'_, T, SA>,
@@ -302,10 +325,12 @@ where
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
-    match (outer.surface().affine_map(), inner.surface().affine_map()) {
-        (Some(a), Some(b)) => Events::new(a, b, inner.rect(), occluders).is_some(),
-        _ => false,
-    }
+    let Some(outer_map) = outer.surface().affine_map() else { return false };
+    let (surface, r) = (inner.surface(), inner.rect());
+    let affine = surface.affine_map();
+    let Ok(bounds) = part_ball(surface, affine, r) else { return false };
+    let use_occluders = occluders.may_block_between(&outer.enclosing_ball(), &bounds);
+    pair_events(outer_map, surface, r, affine, use_occluders, occluders, &bounds).is_some()
 }
 
 /// Most cells into which [`outer_cells`] cuts the outer patch (each costs one outer rule).

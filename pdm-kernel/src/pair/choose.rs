@@ -63,7 +63,9 @@ where
 /// across the small disk's rim), which the outer rule cannot resolve: the patch whose points
 /// stay farther from the other's edges, in its own node spacings, goes outside (the small
 /// disk over the large one). Otherwise the flat one (a curved outer patch sweeps its tangent
-/// plane across the inner one, which adds kinks; a flat one does not).
+/// plane across the inner one, which adds kinks; a flat one does not). Before both, a very
+/// near pair puts its flat patch inside, and a flat patch against a curved one that gives its
+/// outer events goes outside (their kinks are then in the outer rule).
 pub(crate) fn outer_is_b<T, SA, SB, const CAP: usize>(
     a: &Patch<'_, T, SA>,
     b: &Patch<'_, T, SB>,
@@ -83,6 +85,20 @@ where
     // that changes with the order on such a pair.
     if is_flat(a) != is_flat(b) && crate::boundary::very_near(a, b).unwrap_or(false) {
         return is_flat(a);
+    }
+    // A flat patch against a curved one that gives its outer events (a sphere's cells): the
+    // flat one outside, where those events — the curved patch's outline passing its corners and
+    // touching its edges, which also bound the blind points — are placed into the outer rule.
+    #[cfg(feature = "closed-form")]
+    if has_affine_map(a) != has_affine_map(b) {
+        let flat_outside = if has_affine_map(a) {
+            crate::boundary::outer_events_apply(a, b, &())
+        } else {
+            crate::boundary::outer_events_apply(b, a, &())
+        };
+        if flat_outside {
+            return has_affine_map(b);
+        }
     }
     let (blind_a, blind_b) = (blind_points(sa, sb), blind_points(sb, sa));
     if blind_a != blind_b {

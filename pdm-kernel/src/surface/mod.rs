@@ -17,6 +17,7 @@ mod cone;
 mod cylinder;
 mod disk;
 mod parallelogram;
+mod quadric;
 mod quadrilateral;
 mod sphere;
 
@@ -25,6 +26,7 @@ pub use cone::Cone;
 pub use cylinder::Cylinder;
 pub use disk::Disk;
 pub use parallelogram::Parallelogram;
+pub use quadric::Quadric;
 pub use quadrilateral::Quadrilateral;
 pub use sphere::Sphere;
 
@@ -160,6 +162,32 @@ pub trait Surface<T: Real> {
         let _ = (s, p, np);
         None
     }
+    /// `Some([f₁, f₂])` where [`facing_along_t`](Surface::facing_along_t) gives, for every s,
+    /// f = [a, b, c] (a + b·cos t + c·sin t) whose coefficients are themselves first-degree
+    /// trigonometric polynomials in s: each as `[k₀, k_c, k_s]` for k₀ + k_c·cos s + k_s·sin s.
+    /// The inner rule then finds in closed form where the visible set of the t-lines changes
+    /// its structure across s (a test's zero set crossing a t-edge, or tangent to the t-lines)
+    /// instead of probing the edges. Default: `None`.
+    #[cfg(feature = "closed-form")]
+    #[inline]
+    fn facing_across_s(&self, p: Vec3<T>, np: Vec3<T>) -> Option<[[[T; 3]; 3]; 2]> {
+        let _ = (p, np);
+        None
+    }
+    /// Outer-level events of the patch over `rect` as the inner patch of a pair that no
+    /// occluder cuts (used by `boundary/` to place them into the outer rule of a flat outer
+    /// patch): passes to `out` quadrics F(p) such that the part of the patch whose facing test
+    /// n_q·(p − q) > 0 holds changes its structure (its outline passing through a corner of
+    /// the patch, or touching an edge) only where some F(p) = 0 (extra quadrics are harmless,
+    /// a missing one is a bug), and returns `true`; or returns `false` (the default: the caller
+    /// then samples across those events). Curves of the outer patch's own facing test are the
+    /// caller's.
+    #[cfg(feature = "closed-form")]
+    #[inline]
+    fn event_quadrics(&self, rect: ParamRect<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
+        let _ = (rect, out);
+        false
+    }
 }
 
 impl<T: Real, S: Surface<T> + ?Sized> Surface<T> for &S {
@@ -190,6 +218,14 @@ impl<T: Real, S: Surface<T> + ?Sized> Surface<T> for &S {
     #[cfg(feature = "closed-form")]
     fn facing_along_t(&self, s: T, p: Vec3<T>, np: Vec3<T>) -> Option<[[T; 3]; 2]> {
         (**self).facing_along_t(s, p, np)
+    }
+    #[cfg(feature = "closed-form")]
+    fn event_quadrics(&self, rect: ParamRect<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
+        (**self).event_quadrics(rect, out)
+    }
+    #[cfg(feature = "closed-form")]
+    fn facing_across_s(&self, p: Vec3<T>, np: Vec3<T>) -> Option<[[[T; 3]; 3]; 2]> {
+        (**self).facing_across_s(p, np)
     }
 }
 
@@ -289,6 +325,17 @@ impl<T: Real, S: Surface<T>> Surface<T> for Flipped<S> {
     fn facing_along_t(&self, s: T, p: Vec3<T>, np: Vec3<T>) -> Option<[[T; 3]; 2]> {
         let [f1, [a, b, c]] = self.0.facing_along_t(s, p, np)?;
         Some([f1, [-a, -b, -c]])
+    }
+    /// The surface's: the facing region flips, its outline does not.
+    #[cfg(feature = "closed-form")]
+    fn event_quadrics(&self, rect: ParamRect<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
+        self.0.event_quadrics(rect, out)
+    }
+    /// The surface's, with the test on q's side negated.
+    #[cfg(feature = "closed-form")]
+    fn facing_across_s(&self, p: Vec3<T>, np: Vec3<T>) -> Option<[[[T; 3]; 3]; 2]> {
+        let [f1, f2] = self.0.facing_across_s(p, np)?;
+        Some([f1, f2.map(|k| k.map(|x| -x))])
     }
 }
 

@@ -107,8 +107,8 @@ impl<T: Real> Surface<T> for Sphere<T> {
     }
     /// Eq. (19) and eq. (21): n = r² sin φ · (unit radial direction).
     fn point_and_normal(&self, phi: T, theta: T) -> (Vec3<T>, Vec3<T>) {
-        let (sp, cp) = (phi.sin(), phi.cos());
-        let (st, ct) = (theta.sin(), theta.cos());
+        let (sp, cp) = phi.sin_cos();
+        let (st, ct) = theta.sin_cos();
         let radial = self.frame.combine(sp * ct, sp * st, cp);
         let p = self.center + radial.scale(self.radius);
         let n = radial.scale(self.radius * self.radius * sp);
@@ -133,6 +133,73 @@ impl<T: Real> Surface<T> for Sphere<T> {
         let from_q = [-r, d.dot(axis), d.dot(u)];
         let from_q = if self.side == Side::Inner { from_q.map(|x| -x) } else { from_q };
         Some([from_p, from_q])
+    }
+    /// [`facing_along_t`](Surface::facing_along_t)'s coefficients as functions of θ: only the
+    /// sin φ coefficient varies, through u_θ = cos θ·u + sin θ·w.
+    #[cfg(feature = "closed-form")]
+    fn facing_across_s(&self, p: Vec3<T>, np: Vec3<T>) -> Option<[[[T; 3]; 3]; 2]> {
+        let axis = self.frame.combine(T::ZERO, T::ZERO, T::ONE);
+        let (u, w) = (self.frame.combine(T::ONE, T::ZERO, T::ZERO), self.frame.combine(T::ZERO, T::ONE, T::ZERO));
+        let (r, z) = (self.radius, T::ZERO);
+        let d = p - self.center;
+        let from_p = [[-np.dot(d), z, z], [r * np.dot(axis), z, z], [z, r * np.dot(u), r * np.dot(w)]];
+        let from_q = [[-r, z, z], [d.dot(axis), z, z], [z, d.dot(u), d.dot(w)]];
+        let from_q = if self.side == Side::Inner { from_q.map(|k| k.map(|x| -x)) } else { from_q };
+        Some([from_p, from_q])
+    }
+    /// A point p sees the sphere's cap (p − c)·x̂ > r (either side: the inside sees the rest);
+    /// over a cell [φ₀, φ₁] × [θ₀, θ₁] that cap's outline passes through a corner x̂ᵢ where
+    /// (p − c)·x̂ᵢ = r (a plane), and touches a parallel φᵢ or a meridian θᵢ on the envelope of
+    /// the tangent planes along that circle ([`super::Quadric::sphere_circle_envelope`]: a cone,
+    /// the cylinder for a meridian's great circle). The outline touches a circle at the point of
+    /// it nearest the cap's centre or farthest from it, which lies on the cell's edge only where
+    /// p's azimuth (for a parallel) or p's polar angle in the meridian's plane (for a meridian)
+    /// lies in the cell's range or opposite it: the guard, a double wedge about the axis or the
+    /// meridian plane's normal (none for a range of π or more). Corners and circles that
+    /// coincide (at a pole, or θ₀ and θ₁ a turn apart) are given once; a pole's parallel is a
+    /// point, whose events are its corner's.
+    #[cfg(feature = "closed-form")]
+    fn event_quadrics(&self, rect: ParamRect<T>, out: &mut dyn FnMut(super::Quadric<T>)) -> bool {
+        let r = self.radius;
+        let radial = |phi: T, theta: T| {
+            let sp = phi.sin();
+            self.frame.combine(sp * theta.cos(), sp * theta.sin(), phi.cos())
+        };
+        let same = |x: Vec3<T>, y: Vec3<T>| (x - y).norm() <= T::GEOMETRY_TOLERANCE;
+        let corners =
+            [radial(rect.t0, rect.s0), radial(rect.t1, rect.s0), radial(rect.t1, rect.s1), radial(rect.t0, rect.s1)];
+        for (k, &x) in corners.iter().enumerate() {
+            if !corners.iter().take(k).any(|&y| same(x, y)) {
+                out(super::Quadric { origin: self.center, m: [T::ZERO; 6], g: x, c: -r, guard: None });
+            }
+        }
+        let axis = self.frame.combine(T::ZERO, T::ZERO, T::ONE);
+        // In-plane direction at angle a from e₀ towards e₁: sin(angle − a) ∝ v·(cos a·e₁ − sin a·e₀).
+        let wedge = |e0: Vec3<T>, e1: Vec3<T>, lo: T, hi: T| {
+            let after = |a: T| e1.scale(a.cos()) - e0.scale(a.sin());
+            (hi - lo < T::PI).then(|| (after(lo), -after(hi)))
+        };
+        let u_at = |theta: T| self.frame.combine(theta.cos(), theta.sin(), T::ZERO);
+        let (u, w) = (u_at(T::ZERO), u_at(T::HALF * T::PI));
+        let azimuth = wedge(u, w, rect.s0, rect.s1);
+        for phi in [rect.t0, rect.t1] {
+            if phi.sin().abs() > T::GEOMETRY_TOLERANCE {
+                let q = super::Quadric::sphere_circle_envelope(self.center, r, axis, r * phi.cos());
+                out(azimuth.map_or(q, |(g0, g1)| q.guarded(g0, g1)));
+            }
+        }
+        let meridian = |theta: T| self.frame.combine(-theta.sin(), theta.cos(), T::ZERO);
+        for (k, theta) in [rect.s0, rect.s1].into_iter().enumerate() {
+            let m = meridian(theta);
+            if k == 1 && same(m, meridian(rect.s0)) {
+                continue;
+            }
+            let q = super::Quadric::sphere_circle_envelope(self.center, r, m, T::ZERO);
+            // Polar angle in the meridian's half-plane, from the axis towards u_θ.
+            let polar = wedge(axis, u_at(theta), rect.t0, rect.t1);
+            out(polar.map_or(q, |(g0, g1)| q.guarded(g0, g1)));
+        }
+        true
     }
 }
 

@@ -67,7 +67,7 @@ impl<T: Real> Occluder<T> for AnyOccluder<T> {
         }
     }
     #[cfg(feature = "closed-form")]
-    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Vec3<T>, [T; 6])) -> bool {
+    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
         match self {
             Self::Sphere(o) => o.event_quadrics(corner, edge, out),
             _ => false,
@@ -94,7 +94,7 @@ impl<T: Real> Occluder<T> for () {
         true
     }
     #[cfg(feature = "closed-form")]
-    fn event_quadrics(&self, _corner: Vec3<T>, _edge: Vec3<T>, _out: &mut dyn FnMut(Vec3<T>, [T; 6])) -> bool {
+    fn event_quadrics(&self, _corner: Vec3<T>, _edge: Vec3<T>, _out: &mut dyn FnMut(Quadric<T>)) -> bool {
         true
     }
 }
@@ -115,7 +115,7 @@ impl<T: Real, O: Occluder<T> + ?Sized> Occluder<T> for &O {
         (**self).hides_ball_from(p, b)
     }
     #[cfg(feature = "closed-form")]
-    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Vec3<T>, [T; 6])) -> bool {
+    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
         (**self).event_quadrics(corner, edge, out)
     }
 }
@@ -136,7 +136,7 @@ impl<T: Real, O: Occluder<T>> Occluder<T> for [O] {
         self.iter().any(|o| o.hides_ball_from(p, b))
     }
     #[cfg(feature = "closed-form")]
-    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Vec3<T>, [T; 6])) -> bool {
+    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
         self.iter().all(|o| o.event_quadrics(corner, edge, out))
     }
 }
@@ -157,7 +157,7 @@ impl<T: Real, O: Occluder<T>, const N: usize> Occluder<T> for [O; N] {
         self.as_slice().hides_ball_from(p, b)
     }
     #[cfg(feature = "closed-form")]
-    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Vec3<T>, [T; 6])) -> bool {
+    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
         self.as_slice().event_quadrics(corner, edge, out)
     }
 }
@@ -178,7 +178,7 @@ impl<T: Real, O: Occluder<T>, const N: usize> Occluder<T> for heapless::Vec<O, N
         self.as_slice().hides_ball_from(p, b)
     }
     #[cfg(feature = "closed-form")]
-    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Vec3<T>, [T; 6])) -> bool {
+    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
         self.as_slice().event_quadrics(corner, edge, out)
     }
 }
@@ -199,7 +199,7 @@ impl<T: Real, O: Occluder<T>> Occluder<T> for Option<O> {
         self.as_ref().is_some_and(|o| o.hides_ball_from(p, b))
     }
     #[cfg(feature = "closed-form")]
-    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Vec3<T>, [T; 6])) -> bool {
+    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
         self.as_ref().is_none_or(|o| o.event_quadrics(corner, edge, out))
     }
 }
@@ -220,7 +220,7 @@ impl<T: Real, A: Occluder<T>, B: Occluder<T>> Occluder<T> for (A, B) {
         self.0.hides_ball_from(p, b) || self.1.hides_ball_from(p, b)
     }
     #[cfg(feature = "closed-form")]
-    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Vec3<T>, [T; 6])) -> bool {
+    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
         self.0.event_quadrics(corner, edge, out) && self.1.event_quadrics(corner, edge, out)
     }
 }
@@ -243,7 +243,7 @@ impl<T: Real, A: Occluder<T>, B: Occluder<T>, C: Occluder<T>> Occluder<T> for (A
         self.0.hides_ball_from(p, b) || self.1.hides_ball_from(p, b) || self.2.hides_ball_from(p, b)
     }
     #[cfg(feature = "closed-form")]
-    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Vec3<T>, [T; 6])) -> bool {
+    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
         self.0.event_quadrics(corner, edge, out)
             && self.1.event_quadrics(corner, edge, out)
             && self.2.event_quadrics(corner, edge, out)

@@ -44,6 +44,7 @@ mod sphere;
 #[cfg(test)]
 mod tests;
 
+pub use crate::surface::Quadric;
 pub use bezier::BEZIER_FLATNESS;
 pub use combine::AnyOccluder;
 pub(crate) use roots::polynomial_roots;
@@ -96,14 +97,13 @@ pub trait Occluder<T: Real> {
 
     /// Outer-level events for an inner parallelogram (used by `boundary/` to place them into
     /// the outer rule): for the inner patch's corner `corner` and its edge from `corner` to
-    /// `corner + edge`, passes to `out` quadrics F(p) = (p − apex)ᵀ M (p − apex), as the apex and
-    /// M's entries `[xx, yy, zz, xy, xz, yz]`, such that the visible part of the inner patch
-    /// seen from a point p changes its structure (this occluder's shadow boundary passing
+    /// `corner + edge`, passes to `out` quadrics F(p) such that the visible part of the inner
+    /// patch seen from a point p changes its structure (this occluder's shadow boundary passing
     /// through the corner, or becoming tangent to the edge) only where some F(p) = 0 (extra
     /// quadrics are harmless, a missing one is a bug), and returns `true`; or returns `false`
     /// (the default: the caller then samples across those events).
     #[cfg(feature = "closed-form")]
-    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Vec3<T>, [T; 6])) -> bool {
+    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
         let _ = (corner, edge, out);
         false
     }

@@ -49,14 +49,14 @@ impl<T: Real> Occluder<T> for Sphere<T> {
     /// sphere: (v·(w × d))² = R²|d × v|², i.e. vᵀ(g gᵀ − R²(|d|² I − d dᵀ)) v = 0 with
     /// g = w × d (the two tangent planes through the line).
     #[cfg(feature = "closed-form")]
-    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Vec3<T>, [T; 6])) -> bool {
+    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
         let w = self.center - corner;
         let r2 = self.radius * self.radius;
         let k = w.norm2() - r2;
-        out(corner, [k - w.x * w.x, k - w.y * w.y, k - w.z * w.z, -w.x * w.y, -w.x * w.z, -w.y * w.z]);
+        out(Quadric::cone(corner, [k - w.x * w.x, k - w.y * w.y, k - w.z * w.z, -w.x * w.y, -w.x * w.z, -w.y * w.z]));
         let (g, d) = (w.cross(edge), edge);
         let dd = d.norm2();
-        out(
+        out(Quadric::cone(
             corner,
             [
                 g.x * g.x - r2 * (dd - d.x * d.x),
@@ -66,7 +66,7 @@ impl<T: Real> Occluder<T> for Sphere<T> {
                 g.x * g.z + r2 * d.x * d.z,
                 g.y * g.z + r2 * d.y * d.z,
             ],
-        );
+        ));
         true
     }
     /// With w = q − p and m = c − p the segment meets the sphere iff its direction lies in the

@@ -513,20 +513,13 @@ fn sphere_event_quadrics_vanish_where_the_tangents_are() {
     let (centre, r) = (sphere.center, sphere.radius);
     for _ in 0..2000 {
         let (c, d, p) = (rng.vec(4.0), rng.vec(2.0), rng.vec(4.0));
-        let mut quadrics = [(Vec3::ZERO, [0.0; 6]); 2];
+        let mut quadrics = [Quadric::cone(Vec3::ZERO, [0.0; 6]); 2];
         let mut n = 0;
-        assert!(sphere.event_quadrics(c, d, &mut |apex, m| {
-            quadrics[n] = (apex, m);
+        assert!(sphere.event_quadrics(c, d, &mut |q| {
+            quadrics[n] = q;
             n += 1;
         }));
         assert_eq!(n, 2);
-        let value = |(apex, m): (Vec3<f64>, [f64; 6])| {
-            let v = p - apex;
-            let [xx, yy, zz, xy, xz, yz] = m;
-            v.x * (xx * v.x + xy * v.y + xz * v.z)
-                + v.y * (xy * v.x + yy * v.y + yz * v.z)
-                + v.z * (xz * v.x + yz * v.y + zz * v.z)
-        };
         let v = p - c;
         let w = centre - c;
         let line_distance = w.cross(v).norm() / v.norm();
@@ -535,7 +528,7 @@ fn sphere_event_quadrics_vanish_where_the_tangents_are() {
         let plane_distance = normal.dot(w).abs() / normal.norm();
         let expected_edge = normal.norm2() * (plane_distance * plane_distance - r * r);
         let scale = |e: f64, a: f64| e.abs().max(a.abs()).max(1e-300);
-        let (corner, edge) = (value(quadrics[0]), value(quadrics[1]));
+        let (corner, edge) = (quadrics[0].at(p), quadrics[1].at(p));
         assert!(
             (corner - expected_corner).abs() <= 1e-9 * scale(expected_corner, v.norm2() * w.norm2()),
             "{corner} {expected_corner}"
@@ -545,4 +538,42 @@ fn sphere_event_quadrics_vanish_where_the_tangents_are() {
             "{edge} {expected_edge}"
         );
     }
+}
+
+/// [`Quadric::sphere_circle_envelope`] vanishes on the envelope of the sphere's tangent planes
+/// along a circle: points x + λ·d with x on the circle and d the direction, in the tangent
+/// plane at x, across the circle (so the outline seen from the point touches the circle at x).
+/// Points off the envelope give values of either sign, here checked to be away from zero
+/// for most random points (a quadric that is zero everywhere would pass the first check).
+#[test]
+#[cfg(feature = "closed-form")]
+fn sphere_circle_envelope_vanishes_on_the_tangent_planes_along_the_circle() {
+    let mut rng = Lcg(0x9e37_79b9_7f4a_7c15);
+    let mut off = 0;
+    for _ in 0..2000 {
+        let (centre, r) = (rng.vec(2.0), 0.3 + rng.next().abs());
+        let n = rng.vec(1.0);
+        let n = n.scale(1.0 / n.norm());
+        let h = r * 0.95 * rng.next();
+        let q = Quadric::sphere_circle_envelope(centre, r, n, h);
+        let e1 = n.cross(vec3(0.3, -0.7, 0.2));
+        let e1 = e1.scale(1.0 / e1.norm());
+        let e2 = n.cross(e1);
+        let a = 6.0 * rng.next();
+        let rho = (r * r - h * h).sqrt();
+        let x = centre + n.scale(h) + e1.scale(rho * a.cos()) + e2.scale(rho * a.sin());
+        let xh = (x - centre).scale(1.0 / r);
+        let tau = n.cross(xh);
+        let d = xh.cross(tau.scale(1.0 / tau.norm()));
+        let p = x + d.scale(4.0 * rng.next());
+        let w2 = (p - centre).norm2();
+        let scale = r * r * (w2 + r * r);
+        assert!(q.at(p).abs() <= 1e-9 * scale, "{} against {scale}", q.at(p));
+        let random = centre + rng.vec(4.0);
+        let w2 = (random - centre).norm2();
+        if q.at(random).abs() > 1e-3 * r * r * (w2 + r * r) {
+            off += 1;
+        }
+    }
+    assert!(off > 1900, "{off}");
 }
