@@ -115,3 +115,45 @@ fn sphere_cells_to_a_tilted_rectangle_converge_exponentially() {
     // outside (before) the convergence was algebraic (single pairs 1e-5 off at order 16).
     assert!(e8 < 1e-8 && e12 < 1e-11, "{e6:.1e} {e8:.1e} {e12:.1e}");
 }
+
+/// The tolerance mode on sphere cells that see a cube face's cell only in a sliver (the paper's
+/// sphere, R 1, 8 × 8 cells, against the face x = 3 cut 6 × 6): its estimate must cover its
+/// error. The reference is the fixed-order pair at order 24, which agrees with order 20 to
+/// 1e-12 on these pairs (checked here). Judging the route on 2 × 2 or 3 × 3 samples, as the
+/// tolerance mode did from its geometric start order, missed the back-face cut on such pairs:
+/// the plain sum's orders agreed on values 1e-3 off, with estimates of 3e-9.
+#[test]
+fn tolerance_mode_estimates_cover_sphere_cell_slivers() {
+    use pdm_kernel::{adaptive_exchange, Adaptive, ParamRect};
+    let sphere = Sphere::outer(vec3(0.0, 0.0, 0.0), 1.0).unwrap();
+    let face = Parallelogram::new(vec3(3.0, -3.0, -3.0), vec3(0.0, 0.0, 6.0), vec3(0.0, 6.0, 0.0)).unwrap();
+    let pi = std::f64::consts::PI;
+    for (i, j, u, v) in [(6, 6, 2, 5), (6, 2, 1, 1), (0, 0, 2, 4), (2, 5, 3, 2), (7, 1, 2, 3), (3, 0, 3, 3)] {
+        let cell = ParamRect::new(
+            pi * i as f64 / 8.0,
+            pi * (i + 1) as f64 / 8.0,
+            pi * j as f64 / 4.0,
+            pi * (j + 1) as f64 / 4.0,
+        )
+        .unwrap();
+        let part = ParamRect::new(u as f64 / 6.0, (u + 1) as f64 / 6.0, v as f64 / 6.0, (v + 1) as f64 / 6.0).unwrap();
+        let (a, b) = (Patch::new(&sphere, cell).unwrap(), Patch::new(&face, part).unwrap());
+        let fixed = |order: usize| {
+            let settings = PairSettings { order, singular_order: order, boundaries: true };
+            pair_exchange::<f64, _, _, _, 1024>(&a, &b, settings, &()).unwrap().value
+        };
+        let reference = fixed(24);
+        assert!(((fixed(20) - reference) / reference).abs() < 1e-12, "reference not converged");
+        for tol in [1e-3, 1e-4, 1e-6, 1e-8] {
+            let e = adaptive_exchange::<f64, _, _, _, 1024>(&a, &b, Adaptive::new(tol), &()).unwrap();
+            let (actual, estimate) = ((e.value - reference).abs(), e.error.unwrap());
+            assert!(
+                actual <= estimate && (!e.converged || estimate <= tol * e.value),
+                "cell ({i},{j}) face ({u},{v}) tol {tol:.0e}: off {:.1e}, estimate {:.1e}, converged {}",
+                actual / reference,
+                estimate / e.value,
+                e.converged
+            );
+        }
+    }
+}

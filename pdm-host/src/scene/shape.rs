@@ -4,7 +4,7 @@
 //! from a plane), and [`Shape`], the kernel surface it becomes in the working precision.
 
 use pdm_kernel::{
-    vec3, AnyOccluder, BezierPatch, Cone, Cylinder, Disk, Frame, Parallelogram, ParamRect, Patch, PdmError,
+    vec3, AnyOccluder, BezierPatch, Cone, Cylinder, Disk, Frame, Parallelogram, ParamRect, Patch, PdmError, Quadric,
     Quadrilateral, Real, Side, Sphere, Surface, Vec3,
 };
 
@@ -65,6 +65,12 @@ impl<T: Real> Surface<T> for Shape<T> {
     }
     fn facing_along_t(&self, s: T, p: Vec3<T>, np: Vec3<T>) -> Option<[[T; 3]; 2]> {
         each!(self, g => g.facing_along_t(s, p, np))
+    }
+    fn facing_across_s(&self, p: Vec3<T>, np: Vec3<T>) -> Option<[[[T; 3]; 3]; 2]> {
+        each!(self, g => g.facing_across_s(p, np))
+    }
+    fn event_quadrics(&self, rect: ParamRect<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
+        each!(self, g => g.event_quadrics(rect, out))
     }
 }
 

@@ -124,6 +124,11 @@ pub(super) fn algebraic_leaf<T: Real>(
 pub(super) enum Split {
     /// The larger patch in two ([`split`]): separate pairs.
     Larger,
+    /// The larger patch in two, as `Larger`, but accepted only after two comparisons (three
+    /// orders, as `Both`): pairs across visibility boundaries whose outer events are placed
+    /// into the rule (`boundary/`, outer events), whose first orders on the graded pieces can
+    /// agree by accident while the pieces are still coarse.
+    LargerChecked,
     /// Both patches 2 × 2 ([`split_both`]): touching pairs, whose cells along the contact must
     /// share whole edges or corners to be recognised as touching again (halving one patch
     /// leaves a partial shared edge, which the plain rule would integrate across). Touching
@@ -178,7 +183,9 @@ where
         }
         if next_p + 2 > last_order {
             let children = match how {
-                Split::Larger => split::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, evaluations),
+                Split::Larger | Split::LargerChecked => {
+                    split::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, evaluations)
+                }
                 Split::Both => split_both::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, evaluations),
             };
             return or_parent(children, leaf);

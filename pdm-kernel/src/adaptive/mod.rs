@@ -54,7 +54,11 @@
 //! * Flat pairs by the contour form: the difference between orders 8 and 16 (then 24, 32
 //!   until it meets the tolerance: the contour's 1-D rules are not bound by `max_order`) plus
 //!   the bound on the rounding of the cancelling terms.
-//! * Pairs across visibility boundaries: the outer integrand keeps kinks (a shadow edge meeting
+//! * Pairs across visibility boundaries whose outer events are placed into the outer rule
+//!   (`boundary/`: a flat outer patch against a parallelogram across one sphere, or against a
+//!   sphere's cell): they converge exponentially, and are estimated as smooth pairs by order
+//!   doubling from order 4, accepted only after two comparisons (three orders).
+//! * Other pairs across visibility boundaries: the outer integrand keeps kinks (a shadow edge meeting
 //!   an inner edge), so successive orders — and a patch and its halves — can agree by
 //!   accident. Four approximations are computed: the outer patch whole and split 2 × 2, each
 //!   at orders p and p + 1 (both levels refined: the inner rule's order is the outer one's);

@@ -4,10 +4,18 @@
 use super::*;
 use crate::pair::SeparateRoute;
 
+/// The least order whose samples judge a separate pair's route (whether sample pairs on both
+/// sides of a back-face cut exist). The start order from the geometry can be 2 or 3 for a loose
+/// tolerance, and on 2 × 2 or 3 × 3 samples a sphere cell that sees a face cell only in a sliver
+/// looked wholly hidden: the plain sum's orders then agreed on values 1e-3 off
+/// (`outer_events::tolerance_mode_estimates_cover_sphere_cell_slivers`). 8 × 8 samples are what
+/// the fixed mode judges on at its default order.
+const ROUTE_ORDER: usize = 8;
+
 /// The starting order of a separate pair from its geometry (module docs, item 2), capped at
-/// `max_order`, and the pair's route judged at that order (`PairContext::separate_route`, the
-/// same decision as the fixed-order mode's: the plain sum, or the boundary path with its outer
-/// patch).
+/// `max_order`, and the pair's route judged at that order or [`ROUTE_ORDER`], whichever is
+/// higher (`PairContext::separate_route`, the same decision as the fixed-order mode's: the
+/// plain sum, or the boundary path with its outer patch).
 #[inline(never)]
 pub(super) fn separate_plan<T, SA, SB, O, const CAP: usize>(
     a: &Patch<'_, T, SA>,
@@ -35,7 +43,7 @@ where
         p += 1;
     }
     let p = p.min(settings.max_order);
-    let route = pair.separate_route(p)?;
+    let route = pair.separate_route(p.max(ROUTE_ORDER))?;
     Ok((p, route))
 }
 
@@ -126,10 +134,14 @@ where
 }
 
 /// A pair that a visibility boundary crosses. The boundaries are placed into the inner rule
-/// (`boundary/`), but the outer integrand still has kinks where a boundary
-/// meets the inner patch's edges, and two Gauss orders can agree there by accident. So the error is estimated from the outer patch whole and split
-/// 2 × 2 at two orders ([`across_leaf`], module docs), and the pair is subdivided further while
-/// the estimate exceeds the tolerance.
+/// (`boundary/`). Where the outer events are placed into the outer rule too (a flat outer
+/// patch against a parallelogram across one sphere, or against a sphere's cell), the pair
+/// converges exponentially and is estimated by order doubling ([`by_order_doubling`], three
+/// orders at least). Elsewhere the outer integrand still has kinks where a boundary meets the
+/// inner patch's edges, and two Gauss orders can agree there by accident: the error is
+/// estimated from the outer patch whole and split 2 × 2 at two orders ([`across_leaf`],
+/// module docs). Either way the pair is subdivided further while the estimate exceeds the
+/// tolerance.
 pub(super) fn across_boundaries<T, SA, SB, O, const CAP: usize>(
     a: &Patch<'_, T, SA>,
     b: &Patch<'_, T, SB>,
@@ -143,6 +155,16 @@ where
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
+    // With the outer events placed into the rule the pair converges exponentially in the
+    // order, like a smooth pair: orders 4, 6, … compared as such, the larger patch halved at
+    // `max_order`.
+    #[cfg(feature = "closed-form")]
+    if crate::boundary::outer_events_apply(a, b, occluders) {
+        let eval = |order: usize| {
+            crate::pair::PairContext::<T, SA, SB, O, CAP>::new(a, b, occluders).boundary(order, false, 1, occluders)
+        };
+        return by_order_doubling::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, eval, 4, Split::LargerChecked);
+    }
     let leaf = across_leaf::<T, SA, SB, O, CAP>(a, b, settings, occluders)?;
     if leaf.converged || depth >= settings.max_depth {
         return Ok(leaf);
