@@ -127,7 +127,8 @@ pub(super) enum Split {
     /// The larger patch in two, as `Larger`, but accepted only after two comparisons (three
     /// orders, as `Both`): pairs across visibility boundaries whose outer events are placed
     /// into the rule (`boundary/`, outer events), whose first orders on the graded pieces can
-    /// agree by accident while the pieces are still coarse.
+    /// agree by accident while the pieces are still coarse. (The events are closed-form only.)
+    #[cfg_attr(not(feature = "closed-form"), allow(dead_code))]
     LargerChecked,
     /// Both patches 2 × 2 ([`split_both`]): touching pairs, whose cells along the contact must
     /// share whole edges or corners to be recognised as touching again (halving one patch
