@@ -7,7 +7,12 @@
 //! boundary becomes tangent to an edge of b (a cap of the shadow, δ^{3/2}); across b's plane
 //! it has a kink (b starts facing p). On a parallelogram a and a parallelogram b these curves
 //! are conics in a's parameters: each occluder gives, per corner and edge of b, quadrics in p
-//! ([`Occluder::event_quadrics`]), and b's plane a line. The outer integral is then taken as
+//! ([`Occluder::event_quadrics`]), and b's plane a line. A curved b that no occluder cuts gives
+//! its own ([`Surface::event_quadrics`]: on a sphere's cell the outline seen from p passing a
+//! corner, or touching a parallel or a meridian); a curve that is an event on part of its
+//! quadric only carries a guard, and the ends of that part are breaks in s (there the
+//! edge-tangency curve ends on a corner curve, a point singularity of J). The outer integral
+//! is then taken as
 //! nested line integrals, as the inner one is ("Visibility boundaries" in the references):
 //!
 //! * along s, breaks where a conic crosses one of a's t-edges (a quadratic in s) or becomes

@@ -39,7 +39,10 @@
 //! where two shadows meet is no occluder's curve), they are conics in a's parameters and
 //! are placed into the outer rule the same way (`events.rs`): whole faces across a sphere then
 //! converge exponentially (cube faces against the independent reference: 1.3e-8 / 1.6e-11 at
-//! orders 8 / 12, `pdm-host/tests/outer_events.rs`). Elsewhere the outer rule samples across
+//! orders 8 / 12, `pdm-host/tests/outer_events.rs`). A flat a against a curved b that no
+//! occluder cuts gets b's own curves where b gives them ([`Surface::event_quadrics`]: a sphere's
+//! cells; sphere cells summed against a tilted rectangle: 3.6e-10 / 2.9e-13 at orders 8 / 12
+//! against Ω/4π, same test file). Elsewhere the outer rule samples across
 //! them (algebraic convergence), which patch grids (and the outer split in [`crate::pair`])
 //! reduce.
 //!
