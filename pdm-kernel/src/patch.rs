@@ -5,7 +5,7 @@ use crate::error::PdmError;
 use crate::gauss::GaussRule;
 use crate::real::Real;
 use crate::surface::{ParamRect, Surface};
-use crate::vec3::Ball;
+use crate::vec3::{vec3, Ball, Vec3};
 
 /// A surface restricted to the parameter rectangle `rect` ⊆ its domain.
 #[derive(Debug)]
@@ -73,6 +73,53 @@ impl<'s, T: Real, S: Surface<T> + ?Sized> Patch<'s, T, S> {
             }
         }
         Ball { center, radius: radius * (T::ONE + T::from_f64(0.125)) }
+    }
+
+    /// A cone that holds the patch's unit normals: its axis and half-angle (radians), from the
+    /// normals on a 5 × 5 grid over the parameter rectangle (corners and edges included),
+    /// widened by the largest angle between neighbouring grid normals, as the enclosing ball
+    /// is widened beyond its grid. `None` where the grid's normals do not fit in a cone of
+    /// half-angle below π/2 (or none is finite and non-zero): the patch's normals are then not
+    /// bounded to one side of any plane, and nothing can be settled from them.
+    pub fn normal_cone(&self) -> Option<(Vec3<T>, T)> {
+        const GRID: usize = 5;
+        let r = self.rect;
+        let step = T::ONE / T::from_usize(GRID - 1);
+        let mut normals = [[None::<Vec3<T>>; GRID]; GRID];
+        let mut sum = vec3(T::ZERO, T::ZERO, T::ZERO);
+        for (i, row) in normals.iter_mut().enumerate() {
+            let t = r.t0 + (r.t1 - r.t0) * (T::from_usize(i) * step);
+            for (j, slot) in row.iter_mut().enumerate() {
+                let s = r.s0 + (r.s1 - r.s0) * (T::from_usize(j) * step);
+                let n = self.surface.normal(t, s);
+                let len = n.norm();
+                if len > T::ZERO && len.is_finite() {
+                    let u = n.scale(T::ONE / len);
+                    sum = sum + u;
+                    *slot = Some(u);
+                }
+            }
+        }
+        let len = sum.norm();
+        if !(len > T::ZERO && len.is_finite()) {
+            return None;
+        }
+        let axis = sum.scale(T::ONE / len);
+        let angle = |u: Vec3<T>, v: Vec3<T>| u.cross(v).norm().atan2(u.dot(v));
+        let (mut spread, mut widen) = (T::ZERO, T::ZERO);
+        for (i, row) in normals.iter().enumerate() {
+            for (j, slot) in row.iter().enumerate() {
+                let Some(u) = *slot else { continue };
+                spread = spread.max(angle(axis, u));
+                for (k, l) in [(i + 1, j), (i, j + 1)] {
+                    if let Some(Some(v)) = normals.get(k).and_then(|row| row.get(l)) {
+                        widen = widen.max(angle(u, *v));
+                    }
+                }
+            }
+        }
+        let half_angle = spread + widen;
+        (half_angle < T::PI * T::HALF).then_some((axis, half_angle))
     }
 
     /// Area by eq. (12), A = ∫∫ |n| ds dt, with the `order`-point Gauss rule on each axis.

@@ -10,6 +10,44 @@ pub(crate) fn near<T: Real>(a: &crate::samples::Ball<T>, b: &crate::samples::Bal
     (a.center - b.center).norm() - a.radius - b.radius < a.radius.max(b.radius)
 }
 
+/// `true` if the facing test (`integrand::mutually_facing`) is proven to give one answer for
+/// every pair of points of the two patches — all facing each other, or none — from their normal
+/// cones ([`Patch::normal_cone`]) and enclosing balls: the directions y − x (x on a, y on b) lie
+/// within β = asin((r_a + r_b)/|c_b − c_a|) of the line of centres, so a's normals all face b if
+/// the angle of a's axis to that line plus a's half-angle plus β is below π/2, and all face away
+/// if that angle minus both is above π/2 (the same for b). Samples alone cannot show this: a
+/// patch that sees the other only in a sliver near the cut has every sample pair on one side at
+/// low orders. `false` where it cannot be proven (overlapping balls, normals not within a cone):
+/// the pair then takes the boundary path, which places the cut wherever it lies.
+pub(crate) fn facing_settled<T, SA, SB>(
+    a: &Patch<'_, T, SA>,
+    b: &Patch<'_, T, SB>,
+    ball_a: &crate::samples::Ball<T>,
+    ball_b: &crate::samples::Ball<T>,
+) -> bool
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+{
+    let d = ball_b.center - ball_a.center;
+    let distance = d.norm();
+    let reach = ball_a.radius + ball_b.radius;
+    if !(distance > reach) || !distance.is_finite() {
+        return false;
+    }
+    let (Some((axis_a, half_a)), Some((axis_b, half_b))) = (a.normal_cone(), b.normal_cone()) else {
+        return false;
+    };
+    let beta = reach.atan2(((distance - reach) * (distance + reach)).sqrt());
+    let right = T::PI * T::HALF;
+    let angle = |u: Vec3<T>, v: Vec3<T>| u.cross(v).norm().atan2(u.dot(v));
+    let (gamma_a, gamma_b) = (angle(axis_a, d), angle(axis_b, -d));
+    let all_front = |gamma: T, half: T| gamma + half + beta < right;
+    let all_back = |gamma: T, half: T| gamma - half - beta > right;
+    (all_front(gamma_a, half_a) && all_front(gamma_b, half_b)) || all_back(gamma_a, half_a) || all_back(gamma_b, half_b)
+}
+
 /// Whether the Gauss rules of order `order` resolve the pair
 /// ([`crate::sum::samples_resolved`]), for a caller without a pair context (the
 /// tolerance mode's recursion, which keeps no sample buffer in its own frames).

@@ -127,6 +127,13 @@ where
         Ok(straddles_curvature_cut(sa, sb))
     }
 
+    /// Whether the facing test is proven to give one answer on the whole pair
+    /// ([`facing_settled`]).
+    pub(crate) fn facing_settled(&mut self) -> bool {
+        let (ball_a, ball_b) = self.balls();
+        facing_settled(self.a, self.b, &ball_a, &ball_b)
+    }
+
     /// Whether the patches are closer than the larger one's radius ([`near`]).
     pub(crate) fn near(&mut self) -> bool {
         let (ball_a, ball_b) = self.balls();
@@ -150,11 +157,12 @@ where
 
     /// The route of a separate pair, judged on the samples at `order` (module docs of
     /// [`crate::pair`]): occluded if an occluder may cut ([`PairContext::may_occlude`]), else the
-    /// boundary path if the pair straddles a back-face cut or is near, else the plain sum.
+    /// boundary path if the pair straddles a back-face cut, is near, or is not proven to lie wholly on
+    /// one side of the cut ([`facing_settled`]), else the plain sum.
     pub(crate) fn separate_route(&mut self, order: usize) -> Result<SeparateRoute, PdmError> {
         if self.may_occlude(order)? {
             Ok(SeparateRoute::Occluded { outer_b: self.occluded_outer_is_b() })
-        } else if self.straddles(order)? || self.near() {
+        } else if self.straddles(order)? || self.near() || !self.facing_settled() {
             Ok(SeparateRoute::Boundary { outer_b: self.outer_is_b(order)? })
         } else {
             Ok(SeparateRoute::Plain)

@@ -53,7 +53,6 @@ use crate::real::Real;
 use crate::samples::PatchSamples;
 use crate::singular::{classify_near, touching_unchecked, Adjacency};
 use crate::surface::Surface;
-#[cfg(feature = "closed-form")]
 use crate::vec3::Vec3;
 use crate::visibility::Occluder;
 

@@ -490,7 +490,9 @@ fn point_to_clipped_polygon(p: [f64; 3], n: [f64; 3], poly: &[[f64; 3]]) -> f64 
         let c = cross(r0, r1);
         let norm = dot(c, c).sqrt();
         if norm > 0.0 {
-            let gamma = (dot(r0, r1) / (dot(r0, r0) * dot(r1, r1)).sqrt()).clamp(-1.0, 1.0).acos();
+            // The angle between r0 and r1 by atan2 (acos loses half the digits of small angles,
+            // the short edges of a clipped sliver).
+            let gamma = norm.atan2(dot(r0, r1));
             sum += gamma * dot(n, c) / norm;
         }
     }
@@ -683,6 +685,38 @@ fn cylinder_wall_standing_close_above_a_larger_floor() {
             assert!(rel(ab, fine) < allowed && rel(ba, fine) < allowed, "gap {gap:e} order {order}");
             // The point-to-polygon form costs a few evaluations per outer point.
             assert!(n_ab.max(n_ba) < 2_000_000, "{n_ab} / {n_ba} evaluations");
+        }
+    }
+}
+
+/// A cell of the paper's 8 × 8 sphere just below its equator against a cell of the 6 × 6 top
+/// face that it sees only in a sliver near its terminator, in the tolerance mode at tight
+/// tolerances, both argument orders. Once the pair is halved, a half sees the other patch in
+/// so thin a sliver that every sample pair at the route's order faces away: the route used to
+/// be judged on the samples alone, the half summed to zero with a zero estimate, and the pair
+/// came back 1.0e-4 off with an estimate of 5.4e-13 (tolerance 1e-12). Reference:
+/// [`sphere_cell_to_polygon`] at 128² and 256² sub-cells (shares no code with the kernel).
+#[test]
+fn sphere_cell_seeing_a_face_cell_in_a_sliver_in_the_tolerance_mode() {
+    use core::f64::consts::PI;
+    let poly = [[-2.0, 2.0, 3.0], [-1.0, 2.0, 3.0], [-1.0, 3.0, 3.0], [-2.0, 3.0, 3.0]];
+    let rect = (0.5 * PI, 0.625 * PI, 0.0, 0.25 * PI);
+    let coarse = sphere_cell_to_polygon([0.0; 3], 1.0, rect, &poly, 128);
+    let reference = sphere_cell_to_polygon([0.0; 3], 1.0, rect, &poly, 256);
+    let uncertainty = (coarse - reference).abs();
+    println!("reference {reference:.15e} (128² vs 256²: {:.1e})", rel(coarse, reference));
+    assert!(rel(coarse, reference) < 1e-11);
+    let sphere = Sphere::<f64>::outer(v([0.0; 3]), 1.0).unwrap();
+    let cell = Patch::new(&sphere, ParamRect { t0: rect.0, t1: rect.1, s0: rect.2, s1: rect.3 }).unwrap();
+    let top = square([-3.0, -3.0, 3.0], [0.0, 6.0, 0.0], [6.0, 0.0, 0.0]);
+    let face_cell = Patch::new(&top, ParamRect { t0: 5.0 / 6.0, t1: 1.0, s0: 1.0 / 6.0, s1: 2.0 / 6.0 }).unwrap();
+    for tol in [1e-8, 1e-10, 1e-12] {
+        let ab = adaptive_exchange::<f64, _, _, _, 400>(&cell, &face_cell, Adaptive::new(tol), &()).unwrap();
+        let ba = adaptive_exchange::<f64, _, _, _, 400>(&face_cell, &cell, Adaptive::new(tol), &()).unwrap();
+        for (name, e, r) in [("cell → face", ab, reference), ("face → cell", ba, reference)] {
+            let (error, estimate) = ((e.value - r).abs(), e.error.unwrap());
+            println!("tol {tol:e} {name}: {:.1e} off, estimate {:.1e}", error / r, estimate / r);
+            assert!(error <= estimate + 2.0 * uncertainty, "tol {tol:e} {name}: {error:e} off, estimate {estimate:e}");
         }
     }
 }
