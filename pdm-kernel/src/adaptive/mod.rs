@@ -17,8 +17,9 @@
 //!    bounding balls (`Occluder::may_block_between`), and takes the boundary path
 //!    (`boundary/`: visibility boundaries placed into the inner rule, the
 //!    inner patch refined towards close outer points) when the pair straddles a boundary
-//!    (some sample pairs visible, some not, or an occluder that may cut) or the patches are
-//!    closer than their size; the outer patch is chosen as by `pair_exchange`: without
+//!    (some sample pairs visible, some not; or the facing test not proven uniform on the
+//!    whole pair from the normal cones, `pair::facing_settled`; or an occluder that may cut)
+//!    or the patches are closer than their size; the outer patch is chosen as by `pair_exchange`: without
 //!    occluders the patch whose points stay farther from the other's edges
 //!    (`pair::outer_is_b`), across occluders the smaller one (`pair::occluded_outer_is_b`);
 //! 4. compares orders p, p + 2, …; when the estimate is still above the tolerance at

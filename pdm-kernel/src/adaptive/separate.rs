@@ -9,7 +9,10 @@ use crate::pair::SeparateRoute;
 /// tolerance, and on 2 × 2 or 3 × 3 samples a sphere cell that sees a face cell only in a sliver
 /// looked wholly hidden: the plain sum's orders then agreed on values 1e-3 off
 /// (`outer_events::tolerance_mode_estimates_cover_sphere_cell_slivers`). 8 × 8 samples are what
-/// the fixed mode judges on at its default order.
+/// the fixed mode judges on at its default order. Samples can only show a straddle: a pair
+/// whose samples show none takes the plain sum only where the normal cones prove the facing
+/// test uniform (`pair::facing_settled`; a half of such a sliver pair, split at `max_order`,
+/// has every 8 × 8 sample pair on one side).
 const ROUTE_ORDER: usize = 8;
 
 /// The starting order of a separate pair from its geometry (module docs, item 2), capped at

@@ -10,7 +10,8 @@ use crate::samples::Ball;
 pub(crate) enum SeparateRoute {
     /// Nothing to place into the rule and no occluder can cut: the plain sum.
     Plain,
-    /// The pair straddles a back-face cut (a kink in the integrand), or is closer than its
+    /// The pair straddles a back-face cut (a kink in the integrand; seen on the samples, or
+    /// not proven absent: [`facing_settled`]), or is closer than its
     /// size (the plain rule's nodes do not resolve the kernel's peak, and two orders can agree
     /// on a wrong value), and no occluder can cut: the boundary path, which places the cut into
     /// the inner rule and refines the inner patch towards close outer points, with the outer

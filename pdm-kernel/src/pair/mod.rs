@@ -22,8 +22,9 @@
 //! - The same patch twice uses the identical-panel transform of `singular/`,
 //!   converging exponentially with `singular_order` on a smooth patch.
 //! - Other separate pairs use the PDM sum at `order`. With `boundaries` on, a pair that
-//!   straddles a back-face cut, that an occluder may cut, or whose patches are closer than
-//!   their size gets the visibility boundaries placed into the inner rule and the inner patch
+//!   straddles a back-face cut (seen on the samples, or not proven absent by the patches'
+//!   normal cones: `facing_settled`), that an occluder may cut, or whose patches are closer
+//!   than their size gets the visibility boundaries placed into the inner rule and the inner patch
 //!   refined towards each outer point (`boundary/`; when an occluder may cut, the outer
 //!   events are placed into the outer rule for two parallelograms across one sphere, and the
 //!   outer patch is split `OCCLUDED_OUTER_SPLIT`² otherwise); smooth, distant, unoccludable pairs
