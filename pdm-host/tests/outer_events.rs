@@ -56,9 +56,10 @@ fn whole_faces_across_a_sphere_converge_exponentially() {
     }
 }
 
-/// A sphere cut into cells against a tilted, offset rectangle cut into cells (flat outside,
-/// the sphere's cells inside: their outline's events placed into the outer rule and their
-/// s-breaks in closed form), summed, against F = Ω/4π (the solid angle the rectangle subtends
+/// A sphere cut into cells against a tilted, offset rectangle cut into cells (the sphere's
+/// cells outside with the point-to-polygon form: the circles where a cell's tangent plane
+/// passes a corner of the rectangle's cell, and where it crosses that cell's plane, placed into
+/// the outer rule), summed, against F = Ω/4π (the solid angle the rectangle subtends
 /// at the centre: `reference::closed_form::sphere_to_polygon`, Van Oosterom–Strackee, no
 /// kernel code). Neither the grid nor the placement is the paper's, so no cell edge lines up
 /// with the rectangle.

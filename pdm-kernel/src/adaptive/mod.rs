@@ -57,7 +57,7 @@
 //!   the bound on the rounding of the cancelling terms.
 //! * Pairs across visibility boundaries whose outer events are placed into the outer rule
 //!   (`boundary/`: a flat outer patch against a parallelogram across one sphere, or against a
-//!   sphere's cell): they converge exponentially, and are estimated as smooth pairs by order
+//!   sphere's cell; a sphere's cell against a parallelogram): they converge exponentially, and are estimated as smooth pairs by order
 //!   doubling from order 4, accepted only after two comparisons (three orders).
 //! * Other pairs across visibility boundaries: the outer integrand keeps kinks (a shadow edge meeting
 //!   an inner edge), so successive orders — and a patch and its halves — can agree by

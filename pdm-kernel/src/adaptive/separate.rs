@@ -138,7 +138,8 @@ where
 
 /// A pair that a visibility boundary crosses. The boundaries are placed into the inner rule
 /// (`boundary/`). Where the outer events are placed into the outer rule too (a flat outer
-/// patch against a parallelogram across one sphere, or against a sphere's cell), the pair
+/// patch against a parallelogram across one sphere, or against a sphere's cell; a sphere's
+/// cell against a parallelogram), the pair
 /// converges exponentially and is estimated by order doubling ([`by_order_doubling`], three
 /// orders at least). Elsewhere the outer integrand still has kinks where a boundary meets the
 /// inner patch's edges, and two Gauss orders can agree there by accident: the error is

@@ -1,5 +1,6 @@
-//! Outer-level events: the curves on a flat outer patch where J(p) changes its structure,
-//! placed into the outer rule.
+//! Outer-level events: the curves on the outer patch where J(p) changes its structure, placed
+//! into the outer rule: conics on a flat outer patch ([`Events`]), circles on a sphere's cell
+//! against a parallelogram ([`TrigonometricEvents`]).
 //!
 //! With the inner integral exact for every p, what remains non-smooth is J itself: across an
 //! occluder's shadow it has a kink where the shadow boundary passes through a corner of b
@@ -351,6 +352,167 @@ fn graded_sum<T: Real>(
             continue;
         }
         let (grade_a, grade_b) = (a > lo || at_lo, b < hi || at_hi);
+        let width = b - a;
+        for (x, wx) in rule.points() {
+            let (u, du) = graded((x + T::ONE) * T::HALF, grade_a, grade_b);
+            total += wx * T::HALF * du * width * g(a + width * u)?;
+        }
+    }
+    Ok(total)
+}
+
+/// A curve on a curved outer patch: f(t, s) = a(s) + b(s)·cos t + c(s)·sin t = 0, each of a, b,
+/// c as `[k₀, k_c, k_s]` for k₀ + k_c·cos s + k_s·sin s ([`Surface::facing_across_s`]'s form),
+/// with a and b constant in s (c(s) = ±√(a² − b²) then gives the tangencies in closed form).
+type Trigonometric<T> = [[T; 3]; 3];
+
+/// Most event curves of a curved outer patch against a parallelogram: its four corners and its
+/// plane.
+const MAX_TRIGONOMETRIC_CURVES: usize = 5;
+
+/// Most breaks in s: per curve two on each t-edge and two per tangency sign; ends included.
+const MAX_TRIGONOMETRIC_S_BREAKS: usize = 8 * MAX_TRIGONOMETRIC_CURVES + 2;
+
+/// The outer events of a curved outer patch whose facing tests are trigonometric in both
+/// parameters ([`Surface::facing_across_s`]: a sphere's cells) against a parallelogram b that
+/// no occluder cuts. J(p) is the point-to-polygon form over b clipped by p's tangent plane
+/// (exact), so it changes structure only where that plane passes through a corner of b (the
+/// clipped part grows like δ², its weight like δ: a δ³ kink) and where p crosses b's plane
+/// (b starts facing p). Both are zero sets of facing tests of the outer surface: towards the
+/// corner (n_p·(c − p) = 0) and from the plane (n_b·(p − o_b) = 0); on a sphere they are
+/// circles, a + b·cos φ + c(θ)·sin φ = 0 in its parameters, found in closed form like the
+/// conics above: along s where one crosses a t-edge or is tangent to the t-lines, along each
+/// t-line at its roots, every piece graded towards its breaks.
+pub(super) struct TrigonometricEvents<T> {
+    curves: [Trigonometric<T>; MAX_TRIGONOMETRIC_CURVES],
+    n: usize,
+}
+
+impl<T: Real> TrigonometricEvents<T> {
+    /// The events of the curved outer surface against the parallelogram with affine map
+    /// `inner` over `rect`; `None` if the surface does not give its facing tests in this form,
+    /// a coefficient is not finite, or a curve's a or b varies with s.
+    pub(super) fn new<S: Surface<T> + ?Sized>(
+        outer: &S,
+        inner: (Vec3<T>, Vec3<T>, Vec3<T>),
+        rect: ParamRect<T>,
+    ) -> Option<Self> {
+        let (bo, bt, bs) = inner;
+        let nb = bt.cross(bs);
+        let unit = nb.scale(T::ONE / nb.norm());
+        let mut events = Self { curves: [[[T::ZERO; 3]; 3]; MAX_TRIGONOMETRIC_CURVES], n: 0 };
+        let corner = |t: T, s: T| bo + bt.scale(t) + bs.scale(s);
+        let corners =
+            [corner(rect.t0, rect.s0), corner(rect.t1, rect.s0), corner(rect.t1, rect.s1), corner(rect.t0, rect.s1)];
+        for c in corners {
+            // The second test: the tangent plane at q passing through c.
+            let [_, towards] = outer.facing_across_s(c, unit)?;
+            events.push(towards)?;
+        }
+        let [plane, _] = outer.facing_across_s(bo, unit)?;
+        events.push(plane)?;
+        Some(events)
+    }
+
+    /// Keeps a curve scaled to its largest coefficient 1; `None` where it is not finite, its a
+    /// or b varies with s, or the buffer is full.
+    fn push(&mut self, curve: Trigonometric<T>) -> Option<()> {
+        let [a, b, _] = curve;
+        let constant = |k: [T; 3]| k[1] == T::ZERO && k[2] == T::ZERO;
+        if !curve.iter().flatten().all(|x| x.is_finite()) || !constant(a) || !constant(b) {
+            return None;
+        }
+        let largest = curve.iter().flatten().fold(T::ZERO, |m, x| m.max(x.abs()));
+        let scaled = if largest > T::ZERO { curve.map(|k| k.map(|x| x / largest)) } else { curve };
+        let slot = self.curves.get_mut(self.n)?;
+        *slot = scaled;
+        self.n += 1;
+        Some(())
+    }
+
+    fn used(&self) -> &[Trigonometric<T>] {
+        self.curves.get(..self.n).unwrap_or_default()
+    }
+
+    /// ∫∫ f(t, s) dt ds over `r` with the events placed into the rule (as
+    /// [`Events::integrate`]).
+    pub(super) fn integrate(
+        &self,
+        r: ParamRect<T>,
+        rule: &GaussRule<T>,
+        f: &mut dyn FnMut(T, T) -> Result<T, PdmError>,
+    ) -> Result<T, PdmError> {
+        let mut breaks = [T::ZERO; MAX_TRIGONOMETRIC_S_BREAKS];
+        let mut n = 0usize;
+        let mut tangencies = [T::ZERO; 2 * MAX_TRIGONOMETRIC_CURVES];
+        let mut nt = 0usize;
+        let mut add = |x: T| place(x, r.s0, r.s1, &mut breaks, &mut n);
+        add(r.s0);
+        for &[a, b, c] in self.used() {
+            // A t-edge crossed: f(t_edge, s) = 0, first-degree trigonometric in s.
+            for te in [r.t0, r.t1] {
+                let (st, ct) = te.sin_cos();
+                let g = [a[0] + b[0] * ct + c[0] * st, c[1] * st, c[2] * st];
+                trigonometric_roots(g, r.s0, r.s1, &mut add);
+            }
+            // Tangent to the t-lines: a² = b² + c(s)², c(s) = ±√(a² − b²). The visible part of
+            // a line grows like √(s − s*) there, a singular end point: graded.
+            let k2 = a[0] * a[0] - b[0] * b[0];
+            if k2 >= T::ZERO {
+                let k = k2.sqrt();
+                for sign in [T::ONE, -T::ONE] {
+                    trigonometric_roots([c[0] - sign * k, c[1], c[2]], r.s0, r.s1, &mut |s| {
+                        add(s);
+                        place(s, r.s0, r.s1, &mut tangencies, &mut nt);
+                    });
+                }
+            }
+        }
+        add(r.s1);
+        let tangencies = tangencies.get(..nt).unwrap_or_default();
+        piece_sum(breaks.get_mut(..n).unwrap_or_default(), tangencies, rule, &mut |s| self.line(r, s, rule, f))
+    }
+
+    /// ∫ f(t, s) dt over [r.t0, r.t1] at one s, with breaks at the curves' roots.
+    fn line(
+        &self,
+        r: ParamRect<T>,
+        s: T,
+        rule: &GaussRule<T>,
+        f: &mut dyn FnMut(T, T) -> Result<T, PdmError>,
+    ) -> Result<T, PdmError> {
+        let mut breaks = [T::ZERO; MAX_T_BREAKS];
+        let mut n = 0usize;
+        let mut add = |x: T| place(x, r.t0, r.t1, &mut breaks, &mut n);
+        add(r.t0);
+        let (ss, cs) = s.sin_cos();
+        let at = |k: [T; 3]| k[0] + k[1] * cs + k[2] * ss;
+        for &[a, b, c] in self.used() {
+            trigonometric_roots([at(a), at(b), at(c)], r.t0, r.t1, &mut add);
+        }
+        add(r.t1);
+        piece_sum(breaks.get_mut(..n).unwrap_or_default(), &[], rule, &mut |t| f(t, s))
+    }
+}
+
+/// ∫ g over [lo, hi] by the rule on the pieces between the `breaks` (which hold lo and hi),
+/// each graded ([`graded`]) only at the ends that are in `graded_at`; the other breaks are
+/// kinks whose sides are smooth, which the plain rule on each piece integrates exponentially
+/// (grading there squeezes the rule towards a point where nothing is singular).
+fn piece_sum<T: Real>(
+    breaks: &mut [T],
+    graded_at: &[T],
+    rule: &GaussRule<T>,
+    g: &mut dyn FnMut(T) -> Result<T, PdmError>,
+) -> Result<T, PdmError> {
+    sort(breaks);
+    let mut total = T::ZERO;
+    for w in breaks.windows(2) {
+        let &[a, b] = w else { continue };
+        if !(b > a) {
+            continue;
+        }
+        let (grade_a, grade_b) = (graded_at.contains(&a), graded_at.contains(&b));
         let width = b - a;
         for (x, wx) in rule.points() {
             let (u, du) = graded((x + T::ONE) * T::HALF, grade_a, grade_b);

@@ -420,18 +420,30 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
     /// The terms are O(γ) while J can be O(γ²) (a small polygon far from p): `None` where they
     /// cancel by more than [`POLYGON_CANCELLATION`], and the caller integrates by the rule.
     pub(super) fn point_to_polygon(&self, p: Vec3<T>, np: Vec3<T>) -> Option<T> {
-        let Some((o, et, es)) = self.affine else {
+        if self.affine.is_none() {
             return self.point_to_outline(p, np);
-        };
+        }
+        let (poly, n) = self.clipped(p, np)?;
+        self.tick();
+        let used = poly.get(..n).unwrap_or_default();
+        let (sum, magnitude) = arcs(p, np, used);
+        let j = sum.abs() * T::HALF;
+        (j.is_finite() && magnitude <= T::from_f64(POLYGON_CANCELLATION) * sum.abs()).then_some(j)
+    }
+
+    /// b (a parallelogram) clipped by p's tangent plane (Sutherland–Hodgman against one plane:
+    /// at most 5 vertices), with the number of vertices; no vertices where b faces away from
+    /// p, `None` where b is not a parallelogram.
+    fn clipped(&self, p: Vec3<T>, np: Vec3<T>) -> Option<([Vec3<T>; 5], usize)> {
+        let (o, et, es) = self.affine?;
         let r = self.r;
         let nq = self.surface.normal(r.t0, r.s0);
         let at = |t: T, s: T| o + et.scale(t) + es.scale(s);
         let quad = [at(r.t0, r.s0), at(r.t1, r.s0), at(r.t1, r.s1), at(r.t0, r.s1)];
-        if !(nq.dot(p - quad[0]) > T::ZERO) {
-            return Some(T::ZERO);
-        }
-        // Clip by p's tangent plane (Sutherland–Hodgman against one plane): at most 5 vertices.
         let mut poly = [Vec3::ZERO; 5];
+        if !(nq.dot(p - quad[0]) > T::ZERO) {
+            return Some((poly, 0));
+        }
         let mut n = 0usize;
         let mut keep = |v: Vec3<T>| {
             if let Some(slot) = poly.get_mut(n) {
@@ -449,26 +461,165 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
                 keep(a + (b - a).scale(da / (da - db)));
             }
         }
+        Some((poly, n))
+    }
+
+    /// J(p) over a parallelogram b past one sphere occluder (`ball`) that lies wholly between
+    /// b's plane and p's side of it, in closed form: every ray from p that meets the sphere
+    /// meets it before b's plane, so the visible part of b is, in directions from p, the
+    /// polygon P (b clipped by p's tangent plane) minus the sphere's cone C (axis ŵ towards the
+    /// centre, half-angle α, sin α = R/|c − p|), and J = Π(P) − Π(P ∩ C) with Π the projected
+    /// solid angle ½ ∮ n̂_p·(u × du) over a region's boundary. P ∩ C is convex; its boundary
+    /// is P's edges where they run inside C (great-circle arcs: Lambert's terms, as
+    /// [`Self::point_to_polygon`]) and C's circle where it runs inside P, from each point where
+    /// an edge leaves C to the next where one enters, whose term is in closed form: with
+    /// u(ψ) = cos α·ŵ + sin α·(cos ψ·e₁ + sin ψ·e₂),
+    ///
+    /// ∫ n̂_p·(u × u′) dψ = sin²α (n̂_p·ŵ) Δψ − sin α cos α [(n̂_p·e₁) Δsin ψ − (n̂_p·e₂) Δcos ψ].
+    ///
+    /// `None` where the sphere does not lie wholly on p's side of b's plane, p is inside it,
+    /// the crossings do not pair up (rounding at a tangency), or the two terms cancel by more
+    /// than [`POLYGON_CANCELLATION`]: the caller then integrates by lines.
+    pub(super) fn point_past_sphere(&self, p: Vec3<T>, np: Vec3<T>, ball: &Ball<T>) -> Option<T> {
+        let (o, et, es) = self.affine?;
+        let nb = et.cross(es);
+        let nb = nb.scale(T::ONE / nb.norm());
+        // The sphere strictly between b's plane and p's side (with a relative margin).
+        let margin = ball.radius * T::GEOMETRY_TOLERANCE.sqrt();
+        let side = nb.dot(p - o);
+        if !(side > T::ZERO && nb.dot(ball.center - o) > ball.radius + margin) {
+            return None;
+        }
+        let (mut poly, n) = self.clipped(p, np)?;
         self.tick();
         if n < 3 {
             return Some(T::ZERO);
         }
-        let (mut sum, mut magnitude) = (T::ZERO, T::ZERO);
-        let used = poly.get(..n).unwrap_or_default();
-        for (k, &v) in used.iter().enumerate() {
-            let Some(&w) = used.get((k + 1) % n) else { continue };
-            let (a, b) = (v - p, w - p);
-            let c = a.cross(b);
-            let sine = c.norm();
-            if !(sine > T::ZERO) {
-                continue;
-            }
-            let term = sine.atan2(a.dot(b)) * np.dot(c) / sine;
-            sum += term;
-            magnitude += term.abs();
+        // Positive orientation about the directions from p (P's normal by the right-hand rule
+        // pointing away from p), which the cone's circle shares with increasing ψ below.
+        let first = poly.first().copied().unwrap_or(Vec3::ZERO);
+        let (second, third) = (poly.get(1).copied().unwrap_or(first), poly.get(2).copied().unwrap_or(first));
+        if (second - first).cross(third - first).dot(first - p) < T::ZERO {
+            poly.get_mut(..n).unwrap_or_default().reverse();
         }
-        let j = sum.abs() * T::HALF;
-        (j.is_finite() && magnitude <= T::from_f64(POLYGON_CANCELLATION) * sum.abs()).then_some(j)
+        let used = poly.get(..n).unwrap_or_default();
+        let (whole, whole_magnitude) = arcs(p, np, used);
+        let w = ball.center - p;
+        let dist2 = w.norm2();
+        let r2 = ball.radius * ball.radius;
+        if !(dist2 > r2) {
+            return None;
+        }
+        let k = dist2 - r2;
+        let inside = |d: Vec3<T>| {
+            let wd = w.dot(d);
+            wd > T::ZERO && wd * wd >= k * d.norm2()
+        };
+        // The cone's frame: ŵ, e₁, e₂ right-handed.
+        let dist = dist2.sqrt();
+        let axis = w.scale(T::ONE / dist);
+        let helper =
+            if axis.x.abs() < T::HALF { vec3(T::ONE, T::ZERO, T::ZERO) } else { vec3(T::ZERO, T::ONE, T::ZERO) };
+        let e1 = helper.cross(axis);
+        let e1 = e1.scale(T::ONE / e1.norm());
+        let e2 = axis.cross(e1);
+        let (sin_a, cos_a) = (ball.radius / dist, k.sqrt() / dist);
+        let angle = |d: Vec3<T>| d.dot(e2).atan2(d.dot(e1));
+        let circle = |from: T, to: T| {
+            let mut delta = to - from;
+            while delta < T::ZERO {
+                delta += T::TWO * T::PI;
+            }
+            let (s0, c0) = from.sin_cos();
+            let (s1, c1) = to.sin_cos();
+            sin_a * sin_a * np.dot(axis) * delta - sin_a * cos_a * (np.dot(e1) * (s1 - s0) - np.dot(e2) * (c1 - c0))
+        };
+        let (mut shadow, mut magnitude) = (T::ZERO, T::ZERO);
+        let (mut first_entry, mut pending_exit): (Option<T>, Option<T>) = (None, None);
+        let (mut entries, mut exits, mut outside) = (0usize, 0usize, false);
+        for (j, &a) in used.iter().enumerate() {
+            let Some(&b) = used.get((j + 1) % n) else { continue };
+            let (da, e) = (a - p, b - a);
+            // g(λ) = (w·d)² − k|d|² along d = da + λ·e: C's boundary where it vanishes.
+            let (wa, we) = (w.dot(da), w.dot(e));
+            let qa = we * we - k * e.norm2();
+            let qb = T::TWO * (wa * we - k * da.dot(e));
+            let qc = wa * wa - k * da.norm2();
+            let mut cuts = [T::ZERO, T::ONE, T::ONE, T::ONE];
+            let mut nc = 1usize;
+            crate::visibility::polynomial_roots(qa, qb, qc, &mut |x| {
+                if x > T::ZERO && x < T::ONE {
+                    if let Some(slot) = cuts.get_mut(nc) {
+                        *slot = x;
+                        nc += 1;
+                    }
+                }
+            });
+            let cuts = cuts.get_mut(..=nc).unwrap_or_default();
+            super::breaks::sort(cuts);
+            for piece in cuts.windows(2) {
+                let &[lo, hi] = piece else { continue };
+                if !(hi > lo) {
+                    continue;
+                }
+                if !inside(da + e.scale((lo + hi) * T::HALF)) {
+                    outside = true;
+                    continue;
+                }
+                let (u, v) = (da + e.scale(lo), da + e.scale(hi));
+                let (term, size) = arc(np, u, v);
+                shadow += term;
+                magnitude += size;
+                if lo > T::ZERO {
+                    entries += 1;
+                    let at = angle(u);
+                    match pending_exit.take() {
+                        Some(exit) => {
+                            let term = circle(exit, at);
+                            shadow += term;
+                            magnitude += term.abs();
+                        }
+                        None => first_entry = Some(at),
+                    }
+                }
+                if hi < T::ONE {
+                    exits += 1;
+                    pending_exit = Some(angle(v));
+                }
+            }
+        }
+        if entries != exits {
+            return None;
+        }
+        if !outside && entries == 0 {
+            // P lies wholly inside C: b is hidden from p.
+            return Some(T::ZERO);
+        }
+        match (pending_exit, first_entry) {
+            (Some(exit), Some(entry)) => {
+                let term = circle(exit, entry);
+                shadow += term;
+                magnitude += term.abs();
+            }
+            (None, None) if entries == 0 && shadow == T::ZERO => {
+                // No edge runs inside C: C lies wholly inside P (its axis inside every edge's
+                // half-space), or apart from it.
+                let within = used
+                    .iter()
+                    .enumerate()
+                    .all(|(j, &a)| used.get((j + 1) % n).is_some_and(|&b| axis.dot((a - p).cross(b - p)) > T::ZERO));
+                if within {
+                    shadow = T::TWO * T::PI * sin_a * sin_a * np.dot(axis);
+                    magnitude = shadow.abs();
+                }
+            }
+            (None, None) => {}
+            _ => return None,
+        }
+        let j = (whole - shadow) * T::HALF;
+        let total = whole_magnitude + magnitude;
+        (j.is_finite() && j >= T::ZERO && total <= T::from_f64(POLYGON_CANCELLATION) * (whole - shadow).abs())
+            .then_some(j)
     }
 
     /// [`Self::point_to_polygon`] on a flat b with curved edges, along its outline
@@ -630,4 +781,30 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
         })?;
         Ok(inner)
     }
+}
+
+/// Lambert's terms over a polygon seen from p: the sum of γ_k n̂_p·(R_k × R_{k+1})/|R_k × R_{k+1}|
+/// over its edges (twice the projected solid angle, signed by the polygon's orientation) and the
+/// sum of their magnitudes.
+fn arcs<T: Real>(p: Vec3<T>, np: Vec3<T>, poly: &[Vec3<T>]) -> (T, T) {
+    let (mut sum, mut magnitude) = (T::ZERO, T::ZERO);
+    for (k, &v) in poly.iter().enumerate() {
+        let Some(&w) = poly.get((k + 1) % poly.len()) else { continue };
+        let (term, size) = arc(np, v - p, w - p);
+        sum += term;
+        magnitude += size;
+    }
+    (sum, magnitude)
+}
+
+/// One great-circle arc's term from direction a to direction b: γ n̂_p·(a × b)/|a × b| (γ the
+/// angle between them), and its magnitude; zero for parallel directions.
+fn arc<T: Real>(np: Vec3<T>, a: Vec3<T>, b: Vec3<T>) -> (T, T) {
+    let c = a.cross(b);
+    let sine = c.norm();
+    if !(sine > T::ZERO) {
+        return (T::ZERO, T::ZERO);
+    }
+    let term = sine.atan2(a.dot(b)) * np.dot(c) / sine;
+    (term, term.abs())
 }

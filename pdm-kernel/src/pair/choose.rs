@@ -102,8 +102,11 @@ where
 /// stay farther from the other's edges, in its own node spacings, goes outside (the small
 /// disk over the large one). Otherwise the flat one (a curved outer patch sweeps its tangent
 /// plane across the inner one, which adds kinks; a flat one does not). Before both, a very
-/// near pair puts its flat patch inside, and a flat patch against a curved one that gives its
-/// outer events goes outside (their kinks are then in the outer rule).
+/// near pair puts its flat patch inside; then a curved patch that gives its own outer events
+/// against a parallelogram goes outside (a sphere's cell: J(p) is the exact point-to-polygon
+/// form, cheap per outer point, and the circles where it kinks are in the outer rule), and
+/// otherwise a flat patch against a curved one that gives its outer events goes outside (their
+/// kinks are then in the outer rule, but each outer point integrates the curved patch by lines).
 pub(crate) fn outer_is_b<T, SA, SB, const CAP: usize>(
     a: &Patch<'_, T, SA>,
     b: &Patch<'_, T, SB>,
@@ -124,11 +127,22 @@ where
     if is_flat(a) != is_flat(b) && crate::boundary::very_near(a, b).unwrap_or(false) {
         return is_flat(a);
     }
-    // A flat patch against a curved one that gives its outer events (a sphere's cells): the
-    // flat one outside, where those events — the curved patch's outline passing its corners and
-    // touching its edges, which also bound the blind points — are placed into the outer rule.
+    // A curved patch that gives its outer events against a parallelogram (a sphere's cell,
+    // `TrigonometricEvents`): the curved one outside, each outer point by the exact
+    // point-to-polygon form. Else a flat patch against a curved one that gives its event
+    // quadrics only: the flat one outside, where those events — the curved patch's outline
+    // passing its corners and touching its edges, which also bound the blind points — are
+    // placed into the outer rule.
     #[cfg(feature = "closed-form")]
     if has_affine_map(a) != has_affine_map(b) {
+        let curved_outside = if has_affine_map(a) {
+            crate::boundary::outer_events_apply(b, a, &())
+        } else {
+            crate::boundary::outer_events_apply(a, b, &())
+        };
+        if curved_outside {
+            return has_affine_map(a);
+        }
         let flat_outside = if has_affine_map(a) {
             crate::boundary::outer_events_apply(a, b, &())
         } else {

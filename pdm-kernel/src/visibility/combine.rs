@@ -67,6 +67,18 @@ impl<T: Real> Occluder<T> for AnyOccluder<T> {
         }
     }
     #[cfg(feature = "closed-form")]
+    fn shadow_sphere(&self, p: Vec3<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
+        match self {
+            Self::Sphere(o) => o.shadow_sphere(p, b),
+            Self::Parallelogram(o) => o.shadow_sphere(p, b),
+            Self::Disk(o) => o.shadow_sphere(p, b),
+            Self::Cylinder(o) => o.shadow_sphere(p, b),
+            Self::Cone(o) => o.shadow_sphere(p, b),
+            Self::Bezier(o) => o.shadow_sphere(p, b),
+            Self::Quadrilateral(o) => o.shadow_sphere(p, b),
+        }
+    }
+    #[cfg(feature = "closed-form")]
     fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
         match self {
             Self::Sphere(o) => o.event_quadrics(corner, edge, out),
@@ -115,6 +127,10 @@ impl<T: Real, O: Occluder<T> + ?Sized> Occluder<T> for &O {
         (**self).hides_ball_from(p, b)
     }
     #[cfg(feature = "closed-form")]
+    fn shadow_sphere(&self, p: Vec3<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
+        (**self).shadow_sphere(p, b)
+    }
+    #[cfg(feature = "closed-form")]
     fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
         (**self).event_quadrics(corner, edge, out)
     }
@@ -134,6 +150,10 @@ impl<T: Real, O: Occluder<T>> Occluder<T> for [O] {
     #[cfg(feature = "closed-form")]
     fn hides_ball_from(&self, p: Vec3<T>, b: &Ball<T>) -> bool {
         self.iter().any(|o| o.hides_ball_from(p, b))
+    }
+    #[cfg(feature = "closed-form")]
+    fn shadow_sphere(&self, p: Vec3<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
+        self.iter().try_fold(None, |one, o| one_shadow(Some(one), o.shadow_sphere(p, b)))
     }
     #[cfg(feature = "closed-form")]
     fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
@@ -157,6 +177,10 @@ impl<T: Real, O: Occluder<T>, const N: usize> Occluder<T> for [O; N] {
         self.as_slice().hides_ball_from(p, b)
     }
     #[cfg(feature = "closed-form")]
+    fn shadow_sphere(&self, p: Vec3<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
+        self.as_slice().shadow_sphere(p, b)
+    }
+    #[cfg(feature = "closed-form")]
     fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
         self.as_slice().event_quadrics(corner, edge, out)
     }
@@ -176,6 +200,10 @@ impl<T: Real, O: Occluder<T>, const N: usize> Occluder<T> for heapless::Vec<O, N
     #[cfg(feature = "closed-form")]
     fn hides_ball_from(&self, p: Vec3<T>, b: &Ball<T>) -> bool {
         self.as_slice().hides_ball_from(p, b)
+    }
+    #[cfg(feature = "closed-form")]
+    fn shadow_sphere(&self, p: Vec3<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
+        self.as_slice().shadow_sphere(p, b)
     }
     #[cfg(feature = "closed-form")]
     fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
@@ -199,6 +227,10 @@ impl<T: Real, O: Occluder<T>> Occluder<T> for Option<O> {
         self.as_ref().is_some_and(|o| o.hides_ball_from(p, b))
     }
     #[cfg(feature = "closed-form")]
+    fn shadow_sphere(&self, p: Vec3<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
+        self.as_ref().map_or(Some(None), |o| o.shadow_sphere(p, b))
+    }
+    #[cfg(feature = "closed-form")]
     fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
         self.as_ref().is_none_or(|o| o.event_quadrics(corner, edge, out))
     }
@@ -218,6 +250,10 @@ impl<T: Real, A: Occluder<T>, B: Occluder<T>> Occluder<T> for (A, B) {
     #[cfg(feature = "closed-form")]
     fn hides_ball_from(&self, p: Vec3<T>, b: &Ball<T>) -> bool {
         self.0.hides_ball_from(p, b) || self.1.hides_ball_from(p, b)
+    }
+    #[cfg(feature = "closed-form")]
+    fn shadow_sphere(&self, p: Vec3<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
+        one_shadow(self.0.shadow_sphere(p, b), self.1.shadow_sphere(p, b))
     }
     #[cfg(feature = "closed-form")]
     fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
@@ -243,9 +279,23 @@ impl<T: Real, A: Occluder<T>, B: Occluder<T>, C: Occluder<T>> Occluder<T> for (A
         self.0.hides_ball_from(p, b) || self.1.hides_ball_from(p, b) || self.2.hides_ball_from(p, b)
     }
     #[cfg(feature = "closed-form")]
+    fn shadow_sphere(&self, p: Vec3<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
+        one_shadow(one_shadow(self.0.shadow_sphere(p, b), self.1.shadow_sphere(p, b)), self.2.shadow_sphere(p, b))
+    }
+    #[cfg(feature = "closed-form")]
     fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
         self.0.event_quadrics(corner, edge, out)
             && self.1.event_quadrics(corner, edge, out)
             && self.2.event_quadrics(corner, edge, out)
+    }
+}
+
+/// Two answers of [`Occluder::shadow_sphere`] combined: nothing from either, the one sphere one
+/// of them gives, or `None` (two spheres, or anything unknown).
+#[cfg(feature = "closed-form")]
+fn one_shadow<T>(x: Option<Option<Ball<T>>>, y: Option<Option<Ball<T>>>) -> Option<Option<Ball<T>>> {
+    match (x?, y?) {
+        (None, one) | (one, None) => Some(one),
+        (Some(_), Some(_)) => None,
     }
 }

@@ -13,6 +13,11 @@ impl<T: Real> Occluder<T> for Sphere<T> {
     fn may_block_between(&self, a: &Ball<T>, b: &Ball<T>) -> bool {
         ball_may_cut_pair(self.center, self.radius, a, b)
     }
+    #[cfg(feature = "closed-form")]
+    fn shadow_sphere(&self, p: Vec3<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
+        let cuts = self.may_block_between(&Ball { center: p, radius: T::ZERO }, b);
+        Some(cuts.then_some(Ball { center: self.center, radius: self.radius }))
+    }
     /// Every segment from p into ball b crosses the sphere when b's cone from p (half-angle β,
     /// sin β = r_b/|c_b − p|) lies inside the sphere's tangent cone (half-angle α,
     /// sin α = R/|c − p|) with margin, θ + β < α for the angle θ between the axes (compared

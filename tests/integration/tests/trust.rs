@@ -720,3 +720,71 @@ fn sphere_cell_seeing_a_face_cell_in_a_sliver_in_the_tolerance_mode() {
         }
     }
 }
+
+/// A sphere cell that the receiver's plane cuts: the rectangle lies in the plane z = 0.3 beside
+/// the sphere (R 1), facing up, so only the part of the cell above the parallel φ* = acos 0.3
+/// sees it, and from there the cell's tangent planes clip it. The cell goes outside with the
+/// point-to-polygon form, and the parallel (where the rectangle starts facing the cell) and the
+/// four circles where the tangent plane passes a corner are its outer events; none lines up
+/// with the cell's edges. Reference: [`sphere_cell_to_polygon`] with the rectangle's own facing
+/// test, split at φ* (a cut the reference knows from the geometry, not from the kernel), at
+/// 64² and 128² sub-cells (shares no code with the kernel). Both argument orders, the fixed
+/// orders and the tolerance mode, whose estimate must cover its error.
+#[test]
+fn sphere_cell_cut_by_the_receivers_plane() {
+    use pdm_kernel::{adaptive_exchange, Adaptive};
+    let poly = [[-0.6, 1.3, 0.3], [0.4, 1.3, 0.3], [0.4, 2.3, 0.3], [-0.6, 2.3, 0.3]];
+    let (f0, f1, t0, t1) = (0.9, 1.5, 1.1, 2.2);
+    let split = 0.3f64.acos();
+    // Below φ* the cell is behind the rectangle's plane: only [f0, φ*] contributes.
+    assert_behind_plane((split, f1, t0, t1), &poly);
+    let coarse = sphere_cell_to_polygon([0.0; 3], 1.0, (f0, split, t0, t1), &poly, 64);
+    let reference = sphere_cell_to_polygon([0.0; 3], 1.0, (f0, split, t0, t1), &poly, 128);
+    let uncertainty = (coarse - reference).abs();
+    println!("reference {reference:.15e} (64² vs 128²: {:.1e})", rel(coarse, reference));
+    assert!(rel(coarse, reference) < 1e-11);
+    let sphere = Sphere::<f64>::outer(v([0.0; 3]), 1.0).unwrap();
+    let cell = Patch::new(&sphere, ParamRect { t0: f0, t1: f1, s0: t0, s1: t1 }).unwrap();
+    let plate = square(poly[0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]);
+    let receiver = Patch::whole(&plate).unwrap();
+    for order in [8, 12] {
+        let ab = pair_exchange::<f64, _, _, _, 256>(&cell, &receiver, accurate(order), &()).unwrap().value;
+        let ba = pair_exchange::<f64, _, _, _, 256>(&receiver, &cell, accurate(order), &()).unwrap().value;
+        println!(
+            "order {order}: cell → plate {:.1e} off, plate → cell {:.1e} off",
+            rel(ab, reference),
+            rel(ba, reference)
+        );
+        let bound = if order == 8 { 1e-8 } else { 1e-11 };
+        assert!(rel(ab, reference) < bound && rel(ba, reference) < bound, "order {order}: {ab:e} {ba:e}");
+    }
+    for tol in [1e-6, 1e-9, 1e-11] {
+        let ab = adaptive_exchange::<f64, _, _, _, 400>(&cell, &receiver, Adaptive::new(tol), &()).unwrap();
+        let ba = adaptive_exchange::<f64, _, _, _, 400>(&receiver, &cell, Adaptive::new(tol), &()).unwrap();
+        for (name, e) in [("cell → plate", ab), ("plate → cell", ba)] {
+            let (error, estimate) = ((e.value - reference).abs(), e.error.unwrap());
+            println!("tol {tol:e} {name}: {:.1e} off, estimate {:.1e}", error / reference, estimate / reference);
+            assert!(error <= estimate + 2.0 * uncertainty, "tol {tol:e} {name}: {error:e} off, estimate {estimate:e}");
+            assert!(error <= tol * reference + 2.0 * uncertainty, "tol {tol:e} {name}: {error:e} off");
+        }
+    }
+}
+
+/// Checks that the part (φ₀, φ₁, θ₀, θ₁) of the unit sphere at the origin lies behind the
+/// polygon's plane (the polygon faces none of it) at its corners and centre: the plane is
+/// z = const and the part's highest points are at φ₀.
+fn assert_behind_plane((f0, f1, t0, t1): (f64, f64, f64, f64), poly: &[[f64; 3]]) {
+    let (c, radius) = ([0.0; 3], 1.0);
+    let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    let (e1, e2) = (sub(poly[1], poly[0]), sub(poly[3], poly[0]));
+    let n = [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]];
+    for (phi, theta) in [(f0, t0), (f0, t1), (f1, t0), (f1, t1), (0.5 * (f0 + f1), 0.5 * (t0 + t1))] {
+        let p = [
+            c[0] + radius * phi.sin() * theta.cos(),
+            c[1] + radius * phi.sin() * theta.sin(),
+            c[2] + radius * phi.cos(),
+        ];
+        let h: f64 = (0..3).map(|i| n[i] * (p[i] - poly[0][i])).sum();
+        assert!(h <= 1e-12, "part not behind the polygon's plane: {h:e}");
+    }
+}
