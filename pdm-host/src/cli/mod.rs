@@ -247,8 +247,8 @@ fn reference(radius: f64, recompute: bool) -> validate::Reference {
 }
 
 /// Accurate mode's orders in the overview (`pdm-ff validate` with no options): the cheapest
-/// fixed setting that keeps every value of the 280-patch scene within 4e-7 in about two
-/// seconds on two cores (BENCHMARKS.md; order 4 is twice as fast but 1.6e-5 off on the
+/// fixed setting that keeps every value of the 280-patch scene within 6e-7 in about one and a
+/// half seconds on two cores (BENCHMARKS.md; order 4 is 1.7× as fast but 1.5e-5 off on the
 /// opposite faces, whose outer rule is graded towards the shadow events).
 const OVERVIEW_ORDER: usize = 5;
 /// See [`OVERVIEW_ORDER`].

@@ -468,18 +468,18 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
     /// b's plane and p's side of it, in closed form: every ray from p that meets the sphere
     /// meets it before b's plane, so the visible part of b is, in directions from p, the
     /// polygon P (b clipped by p's tangent plane) minus the sphere's cone C (axis ŵ towards the
-    /// centre, half-angle α, sin α = R/|c − p|), and J = Π(P) − Π(P ∩ C) with Π the projected
-    /// solid angle ½ ∮ n̂_p·(u × du) over a region's boundary. P ∩ C is convex; its boundary
-    /// is P's edges where they run inside C (great-circle arcs: Lambert's terms, as
-    /// [`Self::point_to_polygon`]) and C's circle where it runs inside P, from each point where
-    /// an edge leaves C to the next where one enters, whose term is in closed form: with
+    /// centre, half-angle α, sin α = R/|c − p|), and J = Π(P \ C) with Π the projected solid
+    /// angle ½ ∮ n̂_p·(u × du) over a region's boundary: P's edges where they run outside C
+    /// (great-circle arcs: Lambert's terms, as [`Self::point_to_polygon`]) and C's circle where
+    /// it runs inside P (P ∩ C is convex), backwards from each point where an edge enters C to
+    /// the one where an edge last left it, whose term is in closed form: with
     /// u(ψ) = cos α·ŵ + sin α·(cos ψ·e₁ + sin ψ·e₂),
     ///
     /// ∫ n̂_p·(u × u′) dψ = sin²α (n̂_p·ŵ) Δψ − sin α cos α [(n̂_p·e₁) Δsin ψ − (n̂_p·e₂) Δcos ψ].
     ///
     /// `None` where the sphere does not lie wholly on p's side of b's plane, p is inside it,
-    /// the crossings do not pair up (rounding at a tangency), or the two terms cancel by more
-    /// than [`POLYGON_CANCELLATION`]: the caller then integrates by lines.
+    /// the crossings do not pair up (rounding at a tangency), or the terms cancel by more than
+    /// [`POLYGON_CANCELLATION`]: the caller then integrates by lines.
     pub(super) fn point_past_sphere(&self, p: Vec3<T>, np: Vec3<T>, ball: &Ball<T>) -> Option<T> {
         let (o, et, es) = self.affine?;
         let nb = et.cross(es);
@@ -503,7 +503,6 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
             poly.get_mut(..n).unwrap_or_default().reverse();
         }
         let used = poly.get(..n).unwrap_or_default();
-        let (whole, whole_magnitude) = arcs(p, np, used);
         let w = ball.center - p;
         let dist2 = w.norm2();
         let r2 = ball.radius * ball.radius;
@@ -534,7 +533,10 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
             let (s1, c1) = to.sin_cos();
             sin_a * sin_a * np.dot(axis) * delta - sin_a * cos_a * (np.dot(e1) * (s1 - s0) - np.dot(e2) * (c1 - c0))
         };
-        let (mut shadow, mut magnitude) = (T::ZERO, T::ZERO);
+        // The visible region P \ C directly (no difference of two projected solid angles that
+        // cancel where the shadow covers most of b): P's edges outside C, and C's circle inside
+        // P traversed backwards.
+        let (mut visible, mut magnitude) = (T::ZERO, T::ZERO);
         let (mut first_entry, mut pending_exit): (Option<T>, Option<T>) = (None, None);
         let (mut entries, mut exits, mut outside) = (0usize, 0usize, false);
         for (j, &a) in used.iter().enumerate() {
@@ -562,21 +564,21 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
                 if !(hi > lo) {
                     continue;
                 }
+                let (u, v) = (da + e.scale(lo), da + e.scale(hi));
                 if !inside(da + e.scale((lo + hi) * T::HALF)) {
                     outside = true;
+                    let (term, size) = arc(np, u, v);
+                    visible += term;
+                    magnitude += size;
                     continue;
                 }
-                let (u, v) = (da + e.scale(lo), da + e.scale(hi));
-                let (term, size) = arc(np, u, v);
-                shadow += term;
-                magnitude += size;
                 if lo > T::ZERO {
                     entries += 1;
                     let at = angle(u);
                     match pending_exit.take() {
                         Some(exit) => {
                             let term = circle(exit, at);
-                            shadow += term;
+                            visible -= term;
                             magnitude += term.abs();
                         }
                         None => first_entry = Some(at),
@@ -598,10 +600,10 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
         match (pending_exit, first_entry) {
             (Some(exit), Some(entry)) => {
                 let term = circle(exit, entry);
-                shadow += term;
+                visible -= term;
                 magnitude += term.abs();
             }
-            (None, None) if entries == 0 && shadow == T::ZERO => {
+            (None, None) if entries == 0 => {
                 // No edge runs inside C: C lies wholly inside P (its axis inside every edge's
                 // half-space), or apart from it.
                 let within = used
@@ -609,17 +611,16 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
                     .enumerate()
                     .all(|(j, &a)| used.get((j + 1) % n).is_some_and(|&b| axis.dot((a - p).cross(b - p)) > T::ZERO));
                 if within {
-                    shadow = T::TWO * T::PI * sin_a * sin_a * np.dot(axis);
-                    magnitude = shadow.abs();
+                    let cap = T::TWO * T::PI * sin_a * sin_a * np.dot(axis);
+                    visible -= cap;
+                    magnitude += cap.abs();
                 }
             }
             (None, None) => {}
             _ => return None,
         }
-        let j = (whole - shadow) * T::HALF;
-        let total = whole_magnitude + magnitude;
-        (j.is_finite() && j >= T::ZERO && total <= T::from_f64(POLYGON_CANCELLATION) * (whole - shadow).abs())
-            .then_some(j)
+        let j = visible * T::HALF;
+        (j.is_finite() && j >= T::ZERO && magnitude <= T::from_f64(POLYGON_CANCELLATION) * visible).then_some(j)
     }
 
     /// [`Self::point_to_polygon`] on a flat b with curved edges, along its outline
