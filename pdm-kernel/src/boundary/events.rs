@@ -342,19 +342,30 @@ fn graded_sum<T: Real>(
     rule: &GaussRule<T>,
     g: &mut dyn FnMut(T) -> Result<T, PdmError>,
 ) -> Result<T, PdmError> {
-    sort(breaks);
     let at_lo = breaks.iter().filter(|&&x| x == lo).count() > 1;
     let at_hi = breaks.iter().filter(|&&x| x == hi).count() > 1;
+    let grade = |x: T| (x > lo && x < hi) || (x == lo && at_lo) || (x == hi && at_hi);
+    sum_pieces(breaks, rule, &grade, g)
+}
+
+/// ∫ g by the rule on the pieces between the `breaks` (sorted here), each piece graded
+/// ([`graded`]) at the ends where `grade` holds.
+fn sum_pieces<T: Real>(
+    breaks: &mut [T],
+    rule: &GaussRule<T>,
+    grade: &dyn Fn(T) -> bool,
+    g: &mut dyn FnMut(T) -> Result<T, PdmError>,
+) -> Result<T, PdmError> {
+    sort(breaks);
     let mut total = T::ZERO;
     for w in breaks.windows(2) {
         let &[a, b] = w else { continue };
         if !(b > a) {
             continue;
         }
-        let (grade_a, grade_b) = (a > lo || at_lo, b < hi || at_hi);
         let width = b - a;
         for (x, wx) in rule.points() {
-            let (u, du) = graded((x + T::ONE) * T::HALF, grade_a, grade_b);
+            let (u, du) = graded((x + T::ONE) * T::HALF, grade(a), grade(b));
             total += wx * T::HALF * du * width * g(a + width * u)?;
         }
     }
@@ -470,7 +481,8 @@ impl<T: Real> TrigonometricEvents<T> {
         }
         add(r.s1);
         let tangencies = tangencies.get(..nt).unwrap_or_default();
-        piece_sum(breaks.get_mut(..n).unwrap_or_default(), tangencies, rule, &mut |s| self.line(r, s, rule, f))
+        let grade = |x: T| tangencies.contains(&x);
+        sum_pieces(breaks.get_mut(..n).unwrap_or_default(), rule, &grade, &mut |s| self.line(r, s, rule, f))
     }
 
     /// ∫ f(t, s) dt over [r.t0, r.t1] at one s, with breaks at the curves' roots.
@@ -491,33 +503,8 @@ impl<T: Real> TrigonometricEvents<T> {
             trigonometric_roots([at(a), at(b), at(c)], r.t0, r.t1, &mut add);
         }
         add(r.t1);
-        piece_sum(breaks.get_mut(..n).unwrap_or_default(), &[], rule, &mut |t| f(t, s))
+        // Its breaks are kinks with smooth sides (δ³ at a corner's circle, linear at the
+        // plane's): the plain rule on each piece, no grading.
+        sum_pieces(breaks.get_mut(..n).unwrap_or_default(), rule, &|_| false, &mut |t| f(t, s))
     }
-}
-
-/// ∫ g over [lo, hi] by the rule on the pieces between the `breaks` (which hold lo and hi),
-/// each graded ([`graded`]) only at the ends that are in `graded_at`; the other breaks are
-/// kinks whose sides are smooth, which the plain rule on each piece integrates exponentially
-/// (grading there squeezes the rule towards a point where nothing is singular).
-fn piece_sum<T: Real>(
-    breaks: &mut [T],
-    graded_at: &[T],
-    rule: &GaussRule<T>,
-    g: &mut dyn FnMut(T) -> Result<T, PdmError>,
-) -> Result<T, PdmError> {
-    sort(breaks);
-    let mut total = T::ZERO;
-    for w in breaks.windows(2) {
-        let &[a, b] = w else { continue };
-        if !(b > a) {
-            continue;
-        }
-        let (grade_a, grade_b) = (graded_at.contains(&a), graded_at.contains(&b));
-        let width = b - a;
-        for (x, wx) in rule.points() {
-            let (u, du) = graded((x + T::ONE) * T::HALF, grade_a, grade_b);
-            total += wx * T::HALF * du * width * g(a + width * u)?;
-        }
-    }
-    Ok(total)
 }
