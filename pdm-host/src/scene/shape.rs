@@ -57,6 +57,9 @@ impl<T: Real> Surface<T> for Shape<T> {
     fn affine_map(&self) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {
         each!(self, g => g.affine_map())
     }
+    fn convex_ball(&self) -> Option<pdm_kernel::Ball<T>> {
+        each!(self, g => g.convex_ball())
+    }
     fn point_and_partials(&self, t: T, s: T) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {
         each!(self, g => g.point_and_partials(t, s))
     }

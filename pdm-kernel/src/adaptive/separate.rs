@@ -81,18 +81,30 @@ where
     O: Occluder<T> + ?Sized,
 {
     let (p, route) = separate_plan::<T, SA, SB, O, CAP>(a, b, settings, occluders)?;
-    if let SeparateRoute::Boundary { outer_b } | SeparateRoute::Occluded { outer_b } = route {
-        // A_a·F_{a→b} = A_b·F_{b→a}: the outer patch is the one the route chose.
-        return if outer_b {
+    // A_a·F_{a→b} = A_b·F_{b→a}: the outer patch is the one the route chose. Off the occluded
+    // route no occluder can cut a segment the pair counts (`PairContext::may_occlude`), and the
+    // pair and its halves are integrated without them, as in the fixed-order mode: an occluder
+    // left in would put its shadow machinery back where the route found none.
+    match route {
+        SeparateRoute::Occluded { outer_b: true } => {
             across_boundaries::<T, SB, SA, O, CAP>(b, a, settings, occluders, depth)
-        } else {
+        }
+        SeparateRoute::Occluded { outer_b: false } => {
             across_boundaries::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth)
-        };
+        }
+        SeparateRoute::Boundary { outer_b: true } => {
+            across_boundaries::<T, SB, SA, (), CAP>(b, a, settings, &(), depth)
+        }
+        SeparateRoute::Boundary { outer_b: false } => {
+            across_boundaries::<T, SA, SB, (), CAP>(a, b, settings, &(), depth)
+        }
+        SeparateRoute::Plain => {
+            // Below order 4 two successive orders can agree by accident; start there.
+            let p = p.max(4).min(settings.max_order - 2);
+            let eval = |order: usize| plain::<T, SA, SB, (), CAP>(a, b, order, &());
+            by_order_doubling::<T, SA, SB, (), CAP>(a, b, settings, &(), depth, eval, p, Split::Larger)
+        }
     }
-    // Below order 4 two successive orders can agree by accident; start there.
-    let p = p.max(4).min(settings.max_order - 2);
-    let eval = |order: usize| plain::<T, SA, SB, O, CAP>(a, b, order, occluders);
-    by_order_doubling::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, eval, p, Split::Larger)
 }
 
 /// The four approximations of a pair across visibility boundaries (module docs): the outer

@@ -480,6 +480,7 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
     /// `None` where the sphere does not lie wholly on p's side of b's plane, p is inside it,
     /// the crossings do not pair up (rounding at a tangency), or the terms cancel by more than
     /// [`POLYGON_CANCELLATION`]: the caller then integrates by lines.
+    #[cfg(feature = "closed-form")]
     pub(super) fn point_past_sphere(&self, p: Vec3<T>, np: Vec3<T>, ball: &Ball<T>) -> Option<T> {
         let (o, et, es) = self.affine?;
         let nb = et.cross(es);

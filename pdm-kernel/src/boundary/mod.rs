@@ -501,7 +501,7 @@ where
     // closed form.
     #[cfg(feature = "closed-form")]
     if occluded_from_p {
-        if let Some(Some(ball)) = occluders.shadow_sphere(p, inner_bounds) {
+        if let Some(Some(ball)) = occluders.shadow_sphere(&Ball { center: p, radius: T::ZERO }, inner_bounds) {
             if let Some(j) = inner.point_past_sphere(p, np, &ball) {
                 return Ok(j);
             }

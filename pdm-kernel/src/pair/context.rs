@@ -102,15 +102,37 @@ where
 
     /// Whether an occluder may cut a segment between the patches: judged on the sample balls at
     /// `order`, then on the enclosing balls (the integrand is smooth only if no occluder cuts
-    /// any segment between the patches, not only between their samples).
+    /// any segment between the patches, not only between their samples). A sphere that one of
+    /// the patches lies on, facing out of it ([`Surface::convex_ball`]), cuts no segment the
+    /// facing test lets through: when it is the only occluder that may cut, the pair is not
+    /// occluded (its terminator is then a boundary of the unoccluded paths, which place it,
+    /// where the occluded ones would see it only through the samples).
     pub(crate) fn may_occlude(&mut self, order: usize) -> Result<bool, PdmError> {
         let occluders = self.occluders;
         let (sa, sb) = self.samples(order)?;
-        if occluders.may_block_between(&sa.bounds(), &sb.bounds()) {
-            return Ok(true);
-        }
+        let cut = occluders.may_block_between(&sa.bounds(), &sb.bounds()) || {
+            let (ball_a, ball_b) = self.balls();
+            occluders.may_block_between(&ball_a, &ball_b)
+        };
+        Ok(cut && !self.only_own_sphere_cuts())
+    }
+
+    /// Whether the only occluder that may cut the pair is a sphere that a or b lies on, facing
+    /// out ([`Surface::convex_ball`]).
+    #[cfg(feature = "closed-form")]
+    fn only_own_sphere_cuts(&mut self) -> bool {
         let (ball_a, ball_b) = self.balls();
-        Ok(occluders.may_block_between(&ball_a, &ball_b))
+        match self.occluders.shadow_sphere(&ball_a, &ball_b) {
+            Some(Some(sphere)) => {
+                self.a.surface().convex_ball() == Some(sphere) || self.b.surface().convex_ball() == Some(sphere)
+            }
+            _ => false,
+        }
+    }
+
+    #[cfg(not(feature = "closed-form"))]
+    fn only_own_sphere_cuts(&mut self) -> bool {
+        false
     }
 
     /// Whether the Gauss rules of order `order` resolve the pair

@@ -33,6 +33,8 @@ pub use sphere::Sphere;
 use crate::dual::{Dual, Scalar};
 use crate::error::PdmError;
 use crate::real::Real;
+#[cfg(feature = "closed-form")]
+use crate::vec3::Ball;
 use crate::vec3::{vec3, Vec3};
 
 /// A parameter rectangle [t0, t1] × [s0, s1].
@@ -188,6 +190,17 @@ pub trait Surface<T: Real> {
         let _ = (rect, out);
         false
     }
+    /// `Some(ball)` if every point of the surface lies on the sphere bounding `ball` and its
+    /// normal points out of it (an outer [`Sphere`]). A segment that starts on such a surface
+    /// and passes the facing test there leaves the ball at once and never re-enters it (the ball
+    /// is convex and lies behind every tangent plane), so that sphere as an occluder cannot cut
+    /// any sample pair the pair counts: the pair methods then leave it out
+    /// (`pair::PairContext::may_occlude`). Default: `None`.
+    #[cfg(feature = "closed-form")]
+    #[inline]
+    fn convex_ball(&self) -> Option<Ball<T>> {
+        None
+    }
 }
 
 impl<T: Real, S: Surface<T> + ?Sized> Surface<T> for &S {
@@ -226,6 +239,10 @@ impl<T: Real, S: Surface<T> + ?Sized> Surface<T> for &S {
     #[cfg(feature = "closed-form")]
     fn facing_across_s(&self, p: Vec3<T>, np: Vec3<T>) -> Option<[[[T; 3]; 3]; 2]> {
         (**self).facing_across_s(p, np)
+    }
+    #[cfg(feature = "closed-form")]
+    fn convex_ball(&self) -> Option<Ball<T>> {
+        (**self).convex_ball()
     }
 }
 

@@ -147,6 +147,12 @@ impl<T: Real> Surface<T> for Sphere<T> {
         let from_q = if self.side == Side::Inner { from_q.map(|k| k.map(|x| -x)) } else { from_q };
         Some([from_p, from_q])
     }
+    /// The outer side lies on the ball's boundary with its normals pointing out; the inner side
+    /// faces into the ball, whose chords it sees.
+    #[cfg(feature = "closed-form")]
+    fn convex_ball(&self) -> Option<crate::vec3::Ball<T>> {
+        (self.side == Side::Outer).then_some(crate::vec3::Ball { center: self.center, radius: self.radius })
+    }
     /// A point p sees the sphere's cap (p − c)·x̂ > r (either side: the inside sees the rest);
     /// over a cell [φ₀, φ₁] × [θ₀, θ₁] that cap's outline passes through a corner x̂ᵢ where
     /// (p − c)·x̂ᵢ = r (a plane), and touches a parallel φᵢ or a meridian θᵢ on the envelope of

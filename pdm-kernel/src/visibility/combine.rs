@@ -67,15 +67,15 @@ impl<T: Real> Occluder<T> for AnyOccluder<T> {
         }
     }
     #[cfg(feature = "closed-form")]
-    fn shadow_sphere(&self, p: Vec3<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
+    fn shadow_sphere(&self, a: &Ball<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
         match self {
-            Self::Sphere(o) => o.shadow_sphere(p, b),
-            Self::Parallelogram(o) => o.shadow_sphere(p, b),
-            Self::Disk(o) => o.shadow_sphere(p, b),
-            Self::Cylinder(o) => o.shadow_sphere(p, b),
-            Self::Cone(o) => o.shadow_sphere(p, b),
-            Self::Bezier(o) => o.shadow_sphere(p, b),
-            Self::Quadrilateral(o) => o.shadow_sphere(p, b),
+            Self::Sphere(o) => o.shadow_sphere(a, b),
+            Self::Parallelogram(o) => o.shadow_sphere(a, b),
+            Self::Disk(o) => o.shadow_sphere(a, b),
+            Self::Cylinder(o) => o.shadow_sphere(a, b),
+            Self::Cone(o) => o.shadow_sphere(a, b),
+            Self::Bezier(o) => o.shadow_sphere(a, b),
+            Self::Quadrilateral(o) => o.shadow_sphere(a, b),
         }
     }
     #[cfg(feature = "closed-form")]
@@ -127,8 +127,8 @@ impl<T: Real, O: Occluder<T> + ?Sized> Occluder<T> for &O {
         (**self).hides_ball_from(p, b)
     }
     #[cfg(feature = "closed-form")]
-    fn shadow_sphere(&self, p: Vec3<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
-        (**self).shadow_sphere(p, b)
+    fn shadow_sphere(&self, a: &Ball<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
+        (**self).shadow_sphere(a, b)
     }
     #[cfg(feature = "closed-form")]
     fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
@@ -152,8 +152,8 @@ impl<T: Real, O: Occluder<T>> Occluder<T> for [O] {
         self.iter().any(|o| o.hides_ball_from(p, b))
     }
     #[cfg(feature = "closed-form")]
-    fn shadow_sphere(&self, p: Vec3<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
-        self.iter().try_fold(None, |one, o| one_shadow(Some(one), o.shadow_sphere(p, b)))
+    fn shadow_sphere(&self, a: &Ball<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
+        self.iter().try_fold(None, |one, o| one_shadow(Some(one), o.shadow_sphere(a, b)))
     }
     #[cfg(feature = "closed-form")]
     fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
@@ -177,8 +177,8 @@ impl<T: Real, O: Occluder<T>, const N: usize> Occluder<T> for [O; N] {
         self.as_slice().hides_ball_from(p, b)
     }
     #[cfg(feature = "closed-form")]
-    fn shadow_sphere(&self, p: Vec3<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
-        self.as_slice().shadow_sphere(p, b)
+    fn shadow_sphere(&self, a: &Ball<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
+        self.as_slice().shadow_sphere(a, b)
     }
     #[cfg(feature = "closed-form")]
     fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
@@ -202,8 +202,8 @@ impl<T: Real, O: Occluder<T>, const N: usize> Occluder<T> for heapless::Vec<O, N
         self.as_slice().hides_ball_from(p, b)
     }
     #[cfg(feature = "closed-form")]
-    fn shadow_sphere(&self, p: Vec3<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
-        self.as_slice().shadow_sphere(p, b)
+    fn shadow_sphere(&self, a: &Ball<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
+        self.as_slice().shadow_sphere(a, b)
     }
     #[cfg(feature = "closed-form")]
     fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
@@ -227,8 +227,8 @@ impl<T: Real, O: Occluder<T>> Occluder<T> for Option<O> {
         self.as_ref().is_some_and(|o| o.hides_ball_from(p, b))
     }
     #[cfg(feature = "closed-form")]
-    fn shadow_sphere(&self, p: Vec3<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
-        self.as_ref().map_or(Some(None), |o| o.shadow_sphere(p, b))
+    fn shadow_sphere(&self, a: &Ball<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
+        self.as_ref().map_or(Some(None), |o| o.shadow_sphere(a, b))
     }
     #[cfg(feature = "closed-form")]
     fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
@@ -252,8 +252,8 @@ impl<T: Real, A: Occluder<T>, B: Occluder<T>> Occluder<T> for (A, B) {
         self.0.hides_ball_from(p, b) || self.1.hides_ball_from(p, b)
     }
     #[cfg(feature = "closed-form")]
-    fn shadow_sphere(&self, p: Vec3<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
-        one_shadow(self.0.shadow_sphere(p, b), self.1.shadow_sphere(p, b))
+    fn shadow_sphere(&self, a: &Ball<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
+        one_shadow(self.0.shadow_sphere(a, b), self.1.shadow_sphere(a, b))
     }
     #[cfg(feature = "closed-form")]
     fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
@@ -279,8 +279,8 @@ impl<T: Real, A: Occluder<T>, B: Occluder<T>, C: Occluder<T>> Occluder<T> for (A
         self.0.hides_ball_from(p, b) || self.1.hides_ball_from(p, b) || self.2.hides_ball_from(p, b)
     }
     #[cfg(feature = "closed-form")]
-    fn shadow_sphere(&self, p: Vec3<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
-        one_shadow(one_shadow(self.0.shadow_sphere(p, b), self.1.shadow_sphere(p, b)), self.2.shadow_sphere(p, b))
+    fn shadow_sphere(&self, a: &Ball<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
+        one_shadow(one_shadow(self.0.shadow_sphere(a, b), self.1.shadow_sphere(a, b)), self.2.shadow_sphere(a, b))
     }
     #[cfg(feature = "closed-form")]
     fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {

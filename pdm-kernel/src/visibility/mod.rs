@@ -108,15 +108,17 @@ pub trait Occluder<T: Real> {
         false
     }
 
-    /// The one sphere that may cut segments from `p` to points of ball `b`: `Some(Some(ball))`
-    /// if this occluder is a sphere that may (a combination: exactly one of its parts is such a
-    /// sphere and no other part may cut), `Some(None)` if nothing may cut
-    /// ([`may_block_between`](Occluder::may_block_between) with `p` as a ball of radius zero),
-    /// `None` otherwise. `boundary/` then takes the inner integral over a parallelogram b from
-    /// `p` in closed form: b's directions minus the sphere's cone of directions.
+    /// The one sphere that may cut segments between points of balls `a` and `b`:
+    /// `Some(Some(ball))` if this occluder is a sphere that may (a combination: exactly one of
+    /// its parts is such a sphere and no other part may cut), `Some(None)` if nothing may cut
+    /// ([`may_block_between`](Occluder::may_block_between)), `None` otherwise. With `a` a point
+    /// (radius zero), `boundary/` then takes the inner integral over a parallelogram b from that
+    /// point in closed form: b's directions minus the sphere's cone of directions; with `a` a
+    /// patch's ball, the pair methods leave out a sphere the patch lies on
+    /// ([`Surface::convex_ball`](crate::Surface::convex_ball)).
     #[cfg(feature = "closed-form")]
-    fn shadow_sphere(&self, p: Vec3<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
-        (!self.may_block_between(&Ball { center: p, radius: T::ZERO }, b)).then_some(None)
+    fn shadow_sphere(&self, a: &Ball<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
+        (!self.may_block_between(a, b)).then_some(None)
     }
 
     /// Conservative culling the other way: `true` only if every segment from `p` to a point of

@@ -14,8 +14,8 @@ impl<T: Real> Occluder<T> for Sphere<T> {
         ball_may_cut_pair(self.center, self.radius, a, b)
     }
     #[cfg(feature = "closed-form")]
-    fn shadow_sphere(&self, p: Vec3<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
-        let cuts = self.may_block_between(&Ball { center: p, radius: T::ZERO }, b);
+    fn shadow_sphere(&self, a: &Ball<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
+        let cuts = self.may_block_between(a, b);
         Some(cuts.then_some(Ball { center: self.center, radius: self.radius }))
     }
     /// Every segment from p into ball b crosses the sphere when b's cone from p (half-angle β,

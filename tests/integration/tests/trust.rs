@@ -788,3 +788,84 @@ fn assert_behind_plane((f0, f1, t0, t1): (f64, f64, f64, f64), poly: &[[f64; 3]]
         assert!(h <= 1e-12, "part not behind the polygon's plane: {h:e}");
     }
 }
+
+/// Sphere cells that see a face cell only in a sliver along their terminator, with the sphere
+/// itself passed as the occluder (as a caller does who lists every surface of a scene): a
+/// segment that leaves an outer sphere's surface through the facing test never re-enters the
+/// ball, so the result must be the unoccluded one. The occluded paths used to take these pairs
+/// and see the sliver only through their samples: the fixed order was up to 9.5e-4 off (the
+/// scene's cell (3, 4) against face 2's cell (3, 5)), and the tolerance mode returned 0 with an
+/// estimate of 0 (converged) for a pair of value 3.9e-12. Reference:
+/// [`sphere_cell_to_polygon`] at 128² and 256² sub-cells (shares no code with the kernel).
+#[test]
+fn sphere_cells_in_a_sliver_with_their_own_sphere_as_occluder() {
+    use core::f64::consts::PI;
+    let sphere = Sphere::<f64>::outer(v([0.0; 3]), 1.0).unwrap();
+    // (cell φ₀, φ₁, θ₀, θ₁; face cell corners o, o + e_t, o + e_t + e_s, o + e_s)
+    let cases = [
+        (
+            (3.0 * PI / 8.0, 0.5 * PI, PI, 1.25 * PI),
+            [[2.0, -3.0, 0.0], [2.0, -3.0, 1.0], [3.0, -3.0, 1.0], [3.0, -3.0, 0.0]],
+        ),
+        (
+            (0.5 * PI, 0.625 * PI, 0.0, 0.25 * PI),
+            [[-2.0, 2.0, 3.0], [-1.0, 2.0, 3.0], [-1.0, 3.0, 3.0], [-2.0, 3.0, 3.0]],
+        ),
+    ];
+    for (rect, poly) in cases {
+        let coarse = sphere_cell_to_polygon([0.0; 3], 1.0, rect, &poly, 128);
+        let reference = sphere_cell_to_polygon([0.0; 3], 1.0, rect, &poly, 256);
+        let uncertainty = (coarse - reference).abs();
+        println!("reference {reference:.15e} (128² vs 256²: {:.1e})", rel(coarse, reference));
+        assert!(reference > 0.0 && rel(coarse, reference) < 1e-6);
+        let cell = Patch::new(&sphere, ParamRect { t0: rect.0, t1: rect.1, s0: rect.2, s1: rect.3 }).unwrap();
+        let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+        // The face cell faces the sphere's centre (the reference's polygon has no side).
+        let (e1, e2) = (sub(poly[1], poly[0]), sub(poly[3], poly[0]));
+        let n = [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]];
+        let towards = -(n[0] * poly[0][0] + n[1] * poly[0][1] + n[2] * poly[0][2]) > 0.0;
+        let plate = if towards { square(poly[0], e1, e2) } else { square(poly[0], e2, e1) };
+        let face_cell = Patch::whole(&plate).unwrap();
+        for order in [8, 12] {
+            for (name, own, free) in [
+                (
+                    "cell → face",
+                    pair_exchange::<f64, _, _, _, 256>(&cell, &face_cell, accurate(order), &sphere).unwrap().value,
+                    pair_exchange::<f64, _, _, _, 256>(&cell, &face_cell, accurate(order), &()).unwrap().value,
+                ),
+                (
+                    "face → cell",
+                    pair_exchange::<f64, _, _, _, 256>(&face_cell, &cell, accurate(order), &sphere).unwrap().value,
+                    pair_exchange::<f64, _, _, _, 256>(&face_cell, &cell, accurate(order), &()).unwrap().value,
+                ),
+            ] {
+                println!(
+                    "order {order} {name}: {:.1e} off, unoccluded {:.1e} off",
+                    rel(own, reference),
+                    rel(free, reference)
+                );
+                assert!(
+                    (own - reference).abs() <= 1e-6 * reference + 2.0 * uncertainty,
+                    "order {order} {name}: {own:e}"
+                );
+                assert_eq!(own, free, "order {order} {name}: the own sphere changed the value");
+            }
+        }
+        for tol in [1e-4, 1e-8, 1e-11] {
+            let ab = adaptive_exchange::<f64, _, _, _, 400>(&cell, &face_cell, Adaptive::new(tol), &sphere).unwrap();
+            let ba = adaptive_exchange::<f64, _, _, _, 400>(&face_cell, &cell, Adaptive::new(tol), &sphere).unwrap();
+            for (name, e) in [("cell → face", ab), ("face → cell", ba)] {
+                let (error, estimate) = ((e.value - reference).abs(), e.error.unwrap());
+                println!("tol {tol:e} {name}: {:.1e} off, estimate {:.1e}", error / reference, estimate / reference);
+                assert!(
+                    error <= estimate + 2.0 * uncertainty,
+                    "tol {tol:e} {name}: {error:e} off, estimate {estimate:e}"
+                );
+                assert!(
+                    !e.converged || error <= tol * reference + 2.0 * uncertainty,
+                    "tol {tol:e} {name}: {error:e} off"
+                );
+            }
+        }
+    }
+}
