@@ -9,7 +9,8 @@
 //!   replaced for flat pairs;
 //! - `c11`: parallel unit squares at distance 1 (C-11);
 //! - `c41`: coaxial unit disks 0.01 apart, whole (C-41; cut into 4 × 4 piece pairs, the contour
-//!   form along the curved edges).
+//!   form along the curved edges);
+//! - `c14-back-to-back`: C-14's squares with the wall radiating away from the floor (exactly 0).
 //!
 //! - `half-wall-0.1`: half a cylinder wall (radius 0.5, height 1) standing 0.1 above a 4 × 4
 //!   floor: curved against flat, straddling the back-face cut and near; the inner integral over
@@ -74,6 +75,14 @@ fn bench_pairs(c: &mut Criterion) {
             bench.iter(|| pair_exchange::<f64, _, _, _, 256>(black_box(&pl), black_box(&pu), s, &()).unwrap().value);
         });
     }
+    // The wall radiating away from the floor: back to back, exactly 0.
+    let back = Parallelogram::new(vec3(0.0, 0.0, 0.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 0.0, 1.0)).unwrap();
+    let pk = Patch::whole(&back).unwrap();
+    let s = settings(8);
+    assert_eq!(pair_exchange::<f64, _, _, _, 256>(&pf, &pk, s, &()).unwrap().value, 0.0);
+    group.bench_with_input(BenchmarkId::new("c14-back-to-back", 8), &8, |bench, _| {
+        bench.iter(|| pair_exchange::<f64, _, _, _, 256>(black_box(&pf), black_box(&pk), s, &()).unwrap().value);
+    });
     group.finish();
     near_flat(c);
     sphere_cells(c);

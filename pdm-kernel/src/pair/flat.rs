@@ -39,6 +39,16 @@ where
     let (shape, b_ahead, a_ahead, cos) = if let (Some((ca, na)), Some((cb, nb))) = (flat_corners(a), flat_corners(b)) {
         let size = ca.iter().chain(cb.iter()).fold(T::ZERO, |m, &p| m.max((p - ca[0]).norm()));
         let band = size * T::GEOMETRY_TOLERANCE;
+        // One parallelogram wholly behind the other's plane (none of its corners ahead, one
+        // beyond the band): no sample pair passes the facing test, the exchange is exactly 0
+        // (back-to-back facets of a mesh, touching or not), whatever occludes.
+        let behind = |corners: &[Vec3<T>; 4], origin: Vec3<T>, n: Vec3<T>| {
+            let heights = corners.map(|q| n.dot(q - origin));
+            heights.iter().all(|&h| h <= band) && heights.iter().any(|&h| h < -band)
+        };
+        if behind(&cb, ca[0], na) || behind(&ca, cb[0], nb) {
+            return Some(Ok((T::ZERO, 0, T::ZERO)));
+        }
         let side = |corners: &[Vec3<T>; 4], origin: Vec3<T>, n: Vec3<T>| {
             let mut ahead = false;
             for &q in corners {

@@ -586,3 +586,49 @@ fn box_floor_row(centre: [f64; 3], radius: f64, order: usize, reversed: bool) {
     );
     assert!(rel(&total, reference) < 1e-5, "{total:?} vs {reference}: {:.2e}", rel(&total, reference));
 }
+
+/// Flat patches one of which lies wholly behind the other's plane — back-to-back facets sharing
+/// an edge or a corner, folded at any angle, and separate ones — never see each other: exactly
+/// 0 in both modes and both argument orders, without integrating (they took the touching
+/// transforms before, 400 µs per shared-corner pair for the same 0). A pair folded the other
+/// way (each in front of the other) stays positive, and a facet that straddles the other's
+/// plane is not taken for hidden.
+#[test]
+fn flat_patches_behind_each_other_are_zero_without_work() {
+    let floor = square::<f64>([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]);
+    let pf = Patch::whole(&floor).unwrap();
+    for degrees in [5.0f64, 60.0, 90.0, 150.0, 179.0] {
+        let (c, s) = (degrees.to_radians().cos(), degrees.to_radians().sin());
+        // A flap hinged on the floor's edge x = 1 (or only at its corner (1, 1, 0)), rising at
+        // `degrees` from the floor's plane, radiating to the side away from the floor.
+        let edge = square::<f64>([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [c, 0.0, s]);
+        let corner = square::<f64>([1.0, 1.0, 0.0], [0.0, 1.0, 0.0], [c, 0.0, s]);
+        let apart = square::<f64>([1.5, 0.0, 0.0], [0.0, 1.0, 0.0], [c, 0.0, s]);
+        for flap in [&edge, &corner, &apart] {
+            let pb = Patch::whole(flap).unwrap();
+            // The flap's normal (0, 1, 0) × (c, 0, s) = (s, 0, −c) points away from the floor
+            // (below its plane for c < 0, behind its far side otherwise): the floor is behind it
+            // or it is behind the floor.
+            for (x, y) in [(&pf, &pb), (&pb, &pf)] {
+                let fixed = pair_exchange::<f64, _, _, _, 256>(x, y, settings(8), &()).unwrap();
+                let tol = adaptive_exchange::<f64, _, _, _, 256>(x, y, Adaptive::new(1e-9), &()).unwrap();
+                assert_eq!((fixed.value, fixed.evaluations), (0.0, 0), "{degrees}°");
+                assert_eq!(
+                    (tol.value, tol.error, tol.converged, tol.evaluations),
+                    (0.0, Some(0.0), true, 0),
+                    "{degrees}°"
+                );
+            }
+        }
+        // Folded the other way (radiating towards the floor): C-14's family, positive.
+        let facing = square::<f64>([1.0, 0.0, 0.0], [c, 0.0, s], [0.0, 1.0, 0.0]);
+        let value =
+            pair_exchange::<f64, _, _, _, 256>(&pf, &Patch::whole(&facing).unwrap(), settings(8), &()).unwrap().value;
+        assert!(value > 0.0, "{degrees}°: {value}");
+    }
+    // A facet standing across the floor's plane sees the floor from its upper half.
+    let across = square::<f64>([2.0, 0.0, -0.5], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0]);
+    let value =
+        pair_exchange::<f64, _, _, _, 256>(&pf, &Patch::whole(&across).unwrap(), settings(12), &()).unwrap().value;
+    assert!(value > 0.0, "straddling: {value}");
+}
