@@ -212,6 +212,14 @@ impl<T: Real> Occluder<T> for SceneOccluder<T> {
             Self::Part(_) => false,
         }
     }
+    /// A whole sphere says so (the kernel then takes a point's view of a parallelogram past it
+    /// in closed form); a part of a surface gives only "nothing may cut".
+    fn shadow_sphere(&self, a: &Ball<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
+        match self {
+            Self::Whole(o) => o.shadow_sphere(a, b),
+            Self::Part(o) => (!o.may_block_between(a, b)).then_some(None),
+        }
+    }
 }
 
 #[cfg(test)]
@@ -326,5 +334,27 @@ mod tests {
             }
             assert!(hits > 300, "{geom:?}: {hits} blocked segments");
         }
+    }
+
+    /// A whole sphere in the scene's occluder list names itself to the kernel (which then takes
+    /// a point's view of a parallelogram past it in closed form); a part of a sphere does not,
+    /// and neither says anything but "nothing may cut" where nothing may.
+    #[test]
+    fn a_whole_sphere_names_itself_as_the_one_shadow() {
+        let frame = Frame::from_axis(vec3(0.0, 0.0, 1.0)).unwrap();
+        let geom = Geom::Sphere { center: vec3(0.0, 0.0, 0.0), radius: 1.0, frame, inner: false };
+        let shape = geom.shape::<f64>().unwrap();
+        let whole = SceneOccluder::Whole(super::super::shape::occluder_of(&shape).unwrap());
+        let d = geom.domain();
+        let part =
+            SceneOccluder::Part(Part::<f64>::new(geom, Rect { t0: d.t0, t1: d.t1 * 0.5, s0: d.s0, s1: d.s1 }).unwrap());
+        let point = |z: f64| Ball { center: vec3(0.0, 0.0, z), radius: 0.0 };
+        let (below, beside) =
+            (Ball { center: vec3(0.0, 0.0, -3.0), radius: 0.5 }, Ball { center: vec3(5.0, 0.0, 3.0), radius: 0.5 });
+        let ball = Ball { center: vec3(0.0, 0.0, 0.0), radius: 1.0 };
+        assert_eq!(whole.shadow_sphere(&point(3.0), &below), Some(Some(ball)));
+        assert_eq!(part.shadow_sphere(&point(3.0), &below), None);
+        assert_eq!(whole.shadow_sphere(&point(3.0), &beside), Some(None));
+        assert_eq!(part.shadow_sphere(&point(3.0), &beside), Some(None));
     }
 }
