@@ -39,28 +39,24 @@ where
     let (shape, b_ahead, a_ahead, cos) = if let (Some((ca, na)), Some((cb, nb))) = (flat_corners(a), flat_corners(b)) {
         let size = ca.iter().chain(cb.iter()).fold(T::ZERO, |m, &p| m.max((p - ca[0]).norm()));
         let band = size * T::GEOMETRY_TOLERANCE;
+        // Where each one's corners lie against the other's plane: (some ahead, some behind),
+        // beyond the band.
+        let sides = |corners: &[Vec3<T>; 4], origin: Vec3<T>, n: Vec3<T>| {
+            corners.iter().fold((false, false), |(ahead, behind), &q| {
+                let h = n.dot(q - origin);
+                (ahead || h > band, behind || h < -band)
+            })
+        };
+        let (b_side, a_side) = (sides(&cb, ca[0], na), sides(&ca, cb[0], nb));
         // One parallelogram wholly behind the other's plane (none of its corners ahead, one
         // beyond the band): no sample pair passes the facing test, the exchange is exactly 0
         // (back-to-back facets of a mesh, touching or not), whatever occludes.
-        let behind = |corners: &[Vec3<T>; 4], origin: Vec3<T>, n: Vec3<T>| {
-            let heights = corners.map(|q| n.dot(q - origin));
-            heights.iter().all(|&h| h <= band) && heights.iter().any(|&h| h < -band)
-        };
-        if behind(&cb, ca[0], na) || behind(&ca, cb[0], nb) {
+        if b_side == (false, true) || a_side == (false, true) {
             return Some(Ok((T::ZERO, 0, T::ZERO)));
         }
-        let side = |corners: &[Vec3<T>; 4], origin: Vec3<T>, n: Vec3<T>| {
-            let mut ahead = false;
-            for &q in corners {
-                let h = n.dot(q - origin);
-                if h < -band {
-                    return None;
-                }
-                ahead |= h > band;
-            }
-            Some(ahead)
-        };
-        (FlatShape::Corners(ca, cb), side(&cb, ca[0], na)?, side(&ca, cb[0], nb)?, na.dot(nb))
+        // Each wholly in front of (or on) the other's plane, or not a flat pair.
+        let side = |(ahead, behind): (bool, bool)| (!behind).then_some(ahead);
+        (FlatShape::Corners(ca, cb), side(b_side)?, side(a_side)?, na.dot(nb))
     } else {
         let oa = crate::contour::Outline::new(a)?;
         let ob = crate::contour::Outline::new(b)?;
