@@ -418,7 +418,7 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
     /// γ_k the angle between R_k and R_{k+1} (Hottel & Sarofim 1967; `../shared/REFERENCES.md`).
     /// Exact however close p comes to b, where a product rule over b needs refining towards p.
     /// The terms are O(γ) while J can be O(γ²) (a small polygon far from p): `None` where they
-    /// cancel by more than [`POLYGON_CANCELLATION`], and the caller integrates by the rule.
+    /// cancel by more than [`polygon_cancellation`], and the caller integrates by the rule.
     pub(super) fn point_to_polygon(&self, p: Vec3<T>, np: Vec3<T>) -> Option<T> {
         if self.affine.is_none() {
             return self.point_to_outline(p, np);
@@ -428,7 +428,7 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
         let used = poly.get(..n).unwrap_or_default();
         let (sum, magnitude) = arcs(p, np, used);
         let j = sum.abs() * T::HALF;
-        (j.is_finite() && magnitude <= T::from_f64(POLYGON_CANCELLATION) * sum.abs()).then_some(j)
+        (j.is_finite() && magnitude <= polygon_cancellation::<T>() * sum.abs()).then_some(j)
     }
 
     /// b (a parallelogram) clipped by p's tangent plane (Sutherland–Hodgman against one plane:
@@ -479,7 +479,7 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
     ///
     /// `None` where the sphere does not lie wholly on p's side of b's plane, p is inside it,
     /// the crossings do not pair up (rounding at a tangency), or the terms cancel by more than
-    /// [`POLYGON_CANCELLATION`]: the caller then integrates by lines.
+    /// [`polygon_cancellation`]: the caller then integrates by lines.
     #[cfg(feature = "closed-form")]
     pub(super) fn point_past_sphere(&self, p: Vec3<T>, np: Vec3<T>, ball: &Ball<T>) -> Option<T> {
         let (o, et, es) = self.affine?;
@@ -621,7 +621,7 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
             _ => return None,
         }
         let j = visible * T::HALF;
-        (j.is_finite() && j >= T::ZERO && magnitude <= T::from_f64(POLYGON_CANCELLATION) * visible).then_some(j)
+        (j.is_finite() && j >= T::ZERO && magnitude <= polygon_cancellation::<T>() * visible).then_some(j)
     }
 
     /// [`Self::point_to_polygon`] on a flat b with curved edges, along its outline
@@ -630,7 +630,7 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
     pub(super) fn point_to_outline(&self, p: Vec3<T>, np: Vec3<T>) -> Option<T> {
         let (j, magnitude, n) = self.outline.as_ref()?.point_form(&self.line_rule, p, np)?;
         self.count.set(self.count.get().saturating_add(n));
-        (magnitude <= T::from_f64(POLYGON_CANCELLATION) * j).then_some(j)
+        (magnitude <= polygon_cancellation::<T>() * j).then_some(j)
     }
 
     /// Without closed forms there is no outline form.
