@@ -810,7 +810,7 @@ pub fn overview(paper: &Report, accurate: &Report) -> String {
             accurate.threads
         ),
         "Every value of one mode: pdm-ff validate --mode paper|accurate [--patches 86|280] [--order P] \
-         [--tolerance T] [--format json|csv] (accurate mode's default orders 8/12 reach 3e-10 at 280 patches); \
+         [--tolerance T] [--format json|csv] (accurate mode's default orders 8/12 reach 4e-11 at 280 patches); \
          pdm-ff validate --help."
             .to_string(),
     ];
