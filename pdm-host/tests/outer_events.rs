@@ -14,13 +14,21 @@
 use pdm_host::reference::cube::cube_face_factors;
 use pdm_kernel::{pair_exchange, vec3, PairSettings, Parallelogram, Patch, Sphere};
 
-/// (F(floor → ceiling), F(floor → wall)) for whole faces at `order` (both orders).
-fn whole_faces(side: f64, radius: f64, order: usize) -> (f64, f64) {
+/// A cube of side `side` centred at the origin with a sphere of `radius` at its centre: the
+/// sphere, the floor (z = −side/2), the ceiling (z = +side/2) and a wall (x = −side/2), each
+/// facing in (the faces of `reference::cube`).
+fn cube(side: f64, radius: f64) -> (Sphere<f64>, [Parallelogram<f64>; 3]) {
     let h = side / 2.0;
     let sphere = Sphere::outer(vec3(0.0, 0.0, 0.0), radius).unwrap();
     let floor = Parallelogram::new(vec3(-h, -h, -h), vec3(side, 0.0, 0.0), vec3(0.0, side, 0.0)).unwrap();
     let ceiling = Parallelogram::new(vec3(-h, -h, h), vec3(0.0, side, 0.0), vec3(side, 0.0, 0.0)).unwrap();
     let wall = Parallelogram::new(vec3(-h, -h, -h), vec3(0.0, side, 0.0), vec3(0.0, 0.0, side)).unwrap();
+    (sphere, [floor, ceiling, wall])
+}
+
+/// (F(floor → ceiling), F(floor → wall)) for whole faces at `order` (both orders).
+fn whole_faces(side: f64, radius: f64, order: usize) -> (f64, f64) {
+    let (sphere, [floor, ceiling, wall]) = cube(side, radius);
     let settings = PairSettings { order, singular_order: order, boundaries: true };
     let f = |other: &Parallelogram<f64>| {
         let e = pair_exchange::<f64, _, _, _, 1024>(
@@ -169,9 +177,7 @@ fn floor_cells_to_ceiling(past: f64, order: usize) -> f64 {
     use pdm_kernel::ParamRect;
     let (side, radius) = (6.0_f64, 1.3_f64);
     let h = side / 2.0;
-    let sphere = Sphere::outer(vec3(0.0, 0.0, 0.0), radius).unwrap();
-    let floor = Parallelogram::new(vec3(-h, -h, -h), vec3(side, 0.0, 0.0), vec3(0.0, side, 0.0)).unwrap();
-    let ceiling = Parallelogram::new(vec3(-h, -h, h), vec3(0.0, side, 0.0), vec3(side, 0.0, 0.0)).unwrap();
+    let (sphere, [floor, ceiling, _]) = cube(side, radius);
     // The line through (y, z) = (h, h) and (y₀, −h) tangent to the circle of radius R:
     // (h² − R²) y₀² + 2h(h² + R²) y₀ + h⁴ − 5R²h² = 0, the root inside the face.
     let (qa, qb, qc) =
@@ -218,10 +224,7 @@ fn cells_across_a_sphere_take_its_shadow_in_closed_form() {
     let (side, radius, n) = (6.0_f64, 1.0_f64, 5usize);
     let r = cube_face_factors(side, radius);
     assert!(r.f_opposite_error < 1e-13, "{r:?}");
-    let h = side / 2.0;
-    let sphere = Sphere::outer(vec3(0.0, 0.0, 0.0), radius).unwrap();
-    let floor = Parallelogram::new(vec3(-h, -h, -h), vec3(side, 0.0, 0.0), vec3(0.0, side, 0.0)).unwrap();
-    let ceiling = Parallelogram::new(vec3(-h, -h, h), vec3(0.0, side, 0.0), vec3(side, 0.0, 0.0)).unwrap();
+    let (sphere, [floor, ceiling, _]) = cube(side, radius);
     let cells = |s| {
         (0..n * n).map(move |k| {
             let (i, j) = ((k / n) as f64, (k % n) as f64);
