@@ -477,9 +477,12 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
     ///
     /// ∫ n̂_p·(u × u′) dψ = sin²α (n̂_p·ŵ) Δψ − sin α cos α [(n̂_p·e₁) Δsin ψ − (n̂_p·e₂) Δcos ψ].
     ///
-    /// `None` where the sphere does not lie wholly on p's side of b's plane, p is inside it,
-    /// the crossings do not pair up (rounding at a tangency), or the terms cancel by more than
-    /// [`polygon_cancellation`]: the caller then integrates by lines.
+    /// The circle's terms are taken from the crossings' directions, and P's boundary is walked
+    /// piece by piece (inside C or not), so that a crossing at a vertex of P counts once.
+    ///
+    /// `None` where the sphere does not lie wholly on p's side of b's plane, p is inside it, or
+    /// the terms cancel by more than [`polygon_cancellation`] against both J and P's
+    /// unshadowed J: the caller then integrates by lines.
     #[cfg(feature = "closed-form")]
     pub(super) fn point_past_sphere(&self, p: Vec3<T>, np: Vec3<T>, ball: &Ball<T>) -> Option<T> {
         let (o, et, es) = self.affine?;
@@ -524,22 +527,39 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
         let e1 = e1.scale(T::ONE / e1.norm());
         let e2 = axis.cross(e1);
         let (sin_a, cos_a) = (ball.radius / dist, k.sqrt() / dist);
-        let angle = |d: Vec3<T>| d.dot(e2).atan2(d.dot(e1));
-        let circle = |from: T, to: T| {
-            let mut delta = to - from;
-            while delta < T::ZERO {
+        // A point of C's circle as its unit direction (cos ψ, sin ψ) about the axis.
+        let angle = |d: Vec3<T>| {
+            let (x, y) = (d.dot(e1), d.dot(e2));
+            let r = (x * x + y * y).sqrt();
+            if r > T::ZERO {
+                (x / r, y / r)
+            } else {
+                (T::ONE, T::ZERO)
+            }
+        };
+        // The circle's term from ψ₀ to ψ₁ (counter-clockwise, Δ = ψ₁ − ψ₀ in [0, 2π)), with
+        // Δsin ψ = 2 cos ψ̄ sin(Δ/2) and Δcos ψ = −2 sin ψ̄ sin(Δ/2) (ψ̄ the mid-angle) and Δ
+        // from the two directions: relative to the arc's length, where differences of angles
+        // and of their sines would carry an absolute ε (a thin sliver of b left visible
+        // beside the cone has short arcs and a J many orders below b's).
+        let circle = |(x0, y0): (T, T), (x1, y1): (T, T)| {
+            let mut delta = (x0 * y1 - y0 * x1).atan2(x0 * x1 + y0 * y1);
+            if delta < T::ZERO {
                 delta += T::TWO * T::PI;
             }
-            let (s0, c0) = from.sin_cos();
-            let (s1, c1) = to.sin_cos();
-            sin_a * sin_a * np.dot(axis) * delta - sin_a * cos_a * (np.dot(e1) * (s1 - s0) - np.dot(e2) * (c1 - c0))
+            let (sh, ch) = (delta * T::HALF).sin_cos();
+            let (mx, my) = (x0 * ch - y0 * sh, x0 * sh + y0 * ch);
+            sin_a * (sin_a * np.dot(axis) * delta - cos_a * T::TWO * sh * (np.dot(e1) * mx + np.dot(e2) * my))
         };
         // The visible region P \ C directly (no difference of two projected solid angles that
         // cancel where the shadow covers most of b): P's edges outside C, and C's circle inside
         // P traversed backwards.
-        let (mut visible, mut magnitude) = (T::ZERO, T::ZERO);
-        let (mut first_entry, mut pending_exit): (Option<T>, Option<T>) = (None, None);
+        // Whether each piece of P's boundary lies in C, piece by piece around P: C's boundary is
+        // crossed where that changes, also at a vertex of P that lies on it (rounding there
+        // can put the edge's root just outside the edge).
+        let mut walk = Crossings { visible: T::ZERO, magnitude: T::ZERO, first_entry: None, pending_exit: None };
         let (mut entries, mut exits, mut outside) = (0usize, 0usize, false);
+        let (mut previous, mut first): (Option<bool>, Option<bool>) = (None, None);
         for (j, &a) in used.iter().enumerate() {
             let Some(&b) = used.get((j + 1) % n) else { continue };
             let (da, e) = (a - p, b - a);
@@ -566,34 +586,32 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
                     continue;
                 }
                 let (u, v) = (da + e.scale(lo), da + e.scale(hi));
-                if !inside(da + e.scale((lo + hi) * T::HALF)) {
+                let now = inside(da + e.scale((lo + hi) * T::HALF));
+                if previous == Some(!now) {
+                    *(if now { &mut entries } else { &mut exits }) += 1;
+                    walk.cross(now, angle(u), &circle);
+                }
+                previous = Some(now);
+                first.get_or_insert(now);
+                if !now {
                     outside = true;
                     let (term, size) = arc(np, u, v);
-                    visible += term;
-                    magnitude += size;
-                    continue;
+                    walk.visible += term;
+                    walk.magnitude += size;
                 }
-                if lo > T::ZERO {
-                    entries += 1;
-                    let at = angle(u);
-                    match pending_exit.take() {
-                        Some(exit) => {
-                            let term = circle(exit, at);
-                            visible -= term;
-                            magnitude += term.abs();
-                        }
-                        None => first_entry = Some(at),
-                    }
-                }
-                if hi < T::ONE {
-                    exits += 1;
-                    pending_exit = Some(angle(v));
-                }
+            }
+        }
+        // Around the last vertex back to the first.
+        if let (Some(last), Some(now), Some(&a)) = (previous, first, used.first()) {
+            if last != now {
+                *(if now { &mut entries } else { &mut exits }) += 1;
+                walk.cross(now, angle(a - p), &circle);
             }
         }
         if entries != exits {
             return None;
         }
+        let Crossings { mut visible, mut magnitude, first_entry, pending_exit } = walk;
         if !outside && entries == 0 {
             // P lies wholly inside C: b is hidden from p.
             return Some(T::ZERO);
@@ -620,8 +638,15 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
             (None, None) => {}
             _ => return None,
         }
+        // The terms' rounding against J, or, where the cone leaves only slivers of P, against
+        // P's own (unshadowed) J: a sliver's J is a difference of nearly equal angles however
+        // it is computed (the lines round the ends of its pieces alike), so no method holds it
+        // to better than a few ε of the unshadowed J.
         let j = visible * T::HALF;
-        (j.is_finite() && j >= T::ZERO && magnitude <= polygon_cancellation::<T>() * visible).then_some(j)
+        let limit = polygon_cancellation::<T>();
+        let settled = magnitude <= limit * visible || magnitude <= limit * arcs(p, np, used).0.abs();
+        let rounding = T::from_f64(5.0) * T::EPSILON * magnitude;
+        (j.is_finite() && j >= -rounding && settled).then_some(j.max(T::ZERO))
     }
 
     /// [`Self::point_to_polygon`] on a flat b with curved edges, along its outline
@@ -809,4 +834,35 @@ fn arc<T: Real>(np: Vec3<T>, a: Vec3<T>, b: Vec3<T>) -> (T, T) {
     }
     let term = sine.atan2(a.dot(b)) * np.dot(c) / sine;
     (term, term.abs())
+}
+
+/// The crossings of P's boundary with the circle of a sphere's cone in [`Inner::point_past_sphere`],
+/// in order around P: each exit from C is joined to the next entry by C's circle, traversed
+/// backwards (its terms subtracted from `visible`).
+#[cfg(feature = "closed-form")]
+struct Crossings<T> {
+    visible: T,
+    magnitude: T,
+    first_entry: Option<(T, T)>,
+    pending_exit: Option<(T, T)>,
+}
+
+#[cfg(feature = "closed-form")]
+impl<T: Real> Crossings<T> {
+    /// C's boundary crossed at the angle `at` about its axis, into C (`entering`) or out of it;
+    /// `circle(from, to)` is the term of C's circle from one angle to the other.
+    fn cross(&mut self, entering: bool, at: (T, T), circle: &dyn Fn((T, T), (T, T)) -> T) {
+        if !entering {
+            self.pending_exit = Some(at);
+            return;
+        }
+        match self.pending_exit.take() {
+            Some(exit) => {
+                let term = circle(exit, at);
+                self.visible -= term;
+                self.magnitude += term.abs();
+            }
+            None => self.first_entry = Some(at),
+        }
+    }
 }
