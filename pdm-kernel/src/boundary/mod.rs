@@ -764,6 +764,54 @@ mod tests {
         }
     }
 
+    /// p's tangent plane leaves only a strip of a square in front of p (its width 1e-2 … 1e-6
+    /// of the square's): J is 1e-4 … 1e-12 of the terms of the point-to-polygon form, which
+    /// must still answer (the lines cost many times more) and agree with the lines at order
+    /// 20 to 1e-15 of the solid angle the square subtends from p (measured: 1.2e-16 at the
+    /// narrowest strip, whose J is 2e-13 of that angle; the old limit sent every strip here to
+    /// the lines).
+    #[test]
+    fn a_strip_of_b_above_the_horizon_is_in_closed_form() {
+        let plate = Parallelogram::new(vec3(-0.5, -0.5, 0.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0)).unwrap();
+        let p = vec3(0.1, -0.2, 1.5);
+        for width in [1e-2, 1e-3, 1e-4, 1e-5, 1e-6] {
+            // The plane through p and the line y = 0.5 − width on b, facing +y.
+            let (a, b) = (vec3(0.0, 0.5 - width, 0.0), vec3(1.0, 0.5 - width, 0.0));
+            let np = (b - a).cross(p - a);
+            let np = np.scale(if np.y > 0.0 { 1.0 } else { -1.0 } / np.norm());
+            let (closed, lines, reach) = in_front(&plate, p, np).expect("answers");
+            assert!(
+                (closed - lines).abs() <= 1e-15 * reach && closed > 0.0,
+                "width {width:e}: closed {closed:e}, lines {lines:e}, reach {reach:e}"
+            );
+        }
+    }
+
+    /// J(p) over `plate` with nothing between: (the point-to-polygon form if it answers, the
+    /// lines at order 20, the solid angle `plate` subtends facing p squarely), or `None`.
+    fn in_front(plate: &Parallelogram<f64>, p: Vec3<f64>, np: Vec3<f64>) -> Option<(f64, f64, f64)> {
+        let b = Patch::whole(plate).unwrap();
+        let count = core::cell::Cell::new(0u64);
+        let inner = Inner {
+            surface: plate,
+            r: b.rect(),
+            rule: GaussRule::<f64>::new(20).unwrap(),
+            probes: 43,
+            affine: plate.affine_map(),
+            trigonometric: false,
+            outline: None,
+            line_rule: GaussRule::<f64>::new(20).unwrap(),
+            use_occluders: false,
+            occluders: &(),
+            count: &count,
+            scratch: core::cell::RefCell::new(LineScratch::new()),
+            signature_line: core::cell::RefCell::new(Line::new()),
+        };
+        let closed = inner.point_to_polygon(p, np)?;
+        let lines = inner.refined(p, np, b.rect(), 0).unwrap();
+        Some((closed, lines, inner.reach(p)))
+    }
+
     /// J(p) past one sphere by the cone subtraction ([`Inner::point_past_sphere`]) against the
     /// lines with the sphere's polynomials ([`Inner::refined`], order 20: exponential in the
     /// order, a different method), from random points in front of random parallelograms with a
