@@ -370,7 +370,9 @@ mod tests {
         let p = Parallelogram::new(vec3(0.0, 0.0, 0.0), vec3(2.0, 0.0, 0.0), vec3(0.5, 3.0, 0.0)).unwrap();
         assert!((Patch::whole(&p).unwrap().area(1).unwrap() - 6.0).abs() < 1e-15);
         let p32 = Parallelogram::new(vec3(0.0_f32, 0.0, 0.0), vec3(2.0, 0.0, 0.0), vec3(0.5, 3.0, 0.0)).unwrap();
-        assert_eq!(Patch::whole(&p32).unwrap().area(1).unwrap(), 6.0);
+        // Exact with libm's square root; within its error with micromath's approximation.
+        let area32 = Patch::whole(&p32).unwrap().area(1).unwrap();
+        assert!((area32 - 6.0).abs() <= 6.0 * <f32 as crate::real::Real>::ELEMENTARY_ERROR, "{area32}");
     }
 
     #[test]

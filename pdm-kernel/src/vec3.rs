@@ -64,6 +64,19 @@ impl<T: crate::real::Real> Vec3<T> {
     #[inline]
     #[must_use]
     pub fn norm(self) -> T {
+        // Directly where the squares neither overflow nor lose the largest component to
+        // underflow (the smaller ones' loss is then below ε of the result); scaled otherwise.
+        let n2 = self.norm2();
+        if n2 < T::MAX && n2 > T::MIN_POSITIVE / T::EPSILON {
+            return n2.sqrt();
+        }
+        self.norm_scaled()
+    }
+
+    /// [`Self::norm`] scaled by the largest component (rare: huge, tiny or non-finite input).
+    #[cold]
+    #[inline(never)]
+    fn norm_scaled(self) -> T {
         let m = self.max_abs();
         if m == T::ZERO || !m.is_finite() {
             return m;

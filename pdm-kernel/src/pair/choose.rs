@@ -186,6 +186,7 @@ where
         };
         g.point(t, s)
     };
+    // Squared distances (a square that overflows only loses a comparison among far points).
     let mut nearest = T::MAX;
     for edge in 0..4 {
         let mut prev = edge_point(edge, 0);
@@ -196,11 +197,12 @@ where
             for p in outer.iter() {
                 let w = p.point - prev;
                 let along = if d2 > T::ZERO { (w.dot(d) / d2).max(T::ZERO).min(T::ONE) } else { T::ZERO };
-                nearest = nearest.min((w - d.scale(along)).norm());
+                nearest = nearest.min((w - d.scale(along)).norm2());
             }
             prev = next;
         }
     }
+    let nearest = nearest.sqrt();
     let order = T::from_usize(outer.len()).sqrt().max(T::ONE);
     let spacing = outer.bounds().radius * T::TWO / order;
     if spacing > T::ZERO {
