@@ -305,7 +305,8 @@ fn help_and_no_subcommand() {
 /// `pdm-ff validate` with no options: the paper's printed values, our paper mode and our
 /// accurate mode side by side at the 280-patch grid. Each row's last column is the accurate
 /// mode's worst relative error against the references (1/6, the independent cube reference,
-/// 1); the paper mode's plain sums for touching patches are visibly off.
+/// 1), within 1e-10 at its default orders (issue 12, item 3); the paper mode's plain sums for
+/// touching patches are visibly off.
 #[test]
 fn no_options_prints_the_overview_at_280_patches() {
     let out = pdm(&["validate"]);
@@ -320,7 +321,7 @@ fn no_options_prints_the_overview_at_280_patches() {
         let tokens: Vec<&str> = line[label.len()..].split_whitespace().collect();
         assert_eq!(tokens.len(), 7, "{line}");
         let (paper_mode, accurate) = (err(tokens[4]), err(tokens[6]));
-        assert!(accurate < 5e-6, "{line}");
+        assert!(accurate < 1e-10, "{line}");
         if label.starts_with("face -> adjacent") || label.starts_with("face sums") {
             assert!(paper_mode > 1e-2, "{line}");
         }

@@ -246,13 +246,13 @@ fn reference(radius: f64, recompute: bool) -> validate::Reference {
     r
 }
 
-/// Accurate mode's orders in the overview (`pdm-ff validate` with no options): the cheapest
-/// fixed setting that keeps every value of the 280-patch scene within 6e-7 in about one and a
-/// half seconds on two cores (BENCHMARKS.md; order 4 is 1.7× as fast but 1.5e-5 off on the
-/// opposite faces, whose outer rule is graded towards the shadow events).
-const OVERVIEW_ORDER: usize = 5;
+/// Accurate mode's orders in the overview (`pdm-ff validate` with no options): its defaults,
+/// which keep every value of the 280-patch scene within 4e-11 in about a second on two cores
+/// (BENCHMARKS.md; orders 7/8 are within 1.5e-10 in three quarters of the time, 5/6 within
+/// 7e-7 in under half).
+const OVERVIEW_ORDER: usize = 8;
 /// See [`OVERVIEW_ORDER`].
-const OVERVIEW_SINGULAR_ORDER: usize = 6;
+const OVERVIEW_SINGULAR_ORDER: usize = 12;
 
 fn run_validate(args: &ValidateArgs) -> ExitCode {
     // No option that picks a method, grid, radius, precision or format: the overview.
