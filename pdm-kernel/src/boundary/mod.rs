@@ -707,6 +707,34 @@ mod tests {
     use super::*;
     use crate::surface::{Parallelogram, Sphere};
 
+    /// `f` on the inner integral over `plate` at order 20 across `occluders` (none if
+    /// `use_occluders` is false).
+    fn at_order_20<O: Occluder<f64>, R>(
+        plate: &Parallelogram<f64>,
+        occluders: &O,
+        use_occluders: bool,
+        f: impl FnOnce(&Inner<'_, f64, Parallelogram<f64>, O>, ParamRect<f64>) -> R,
+    ) -> R {
+        let r = Patch::whole(plate).unwrap().rect();
+        let count = core::cell::Cell::new(0u64);
+        let inner = Inner {
+            surface: plate,
+            r,
+            rule: GaussRule::<f64>::new(20).unwrap(),
+            probes: 43,
+            affine: plate.affine_map(),
+            trigonometric: false,
+            outline: None,
+            line_rule: GaussRule::<f64>::new(20).unwrap(),
+            use_occluders,
+            occluders,
+            count: &count,
+            scratch: core::cell::RefCell::new(LineScratch::new()),
+            signature_line: core::cell::RefCell::new(Line::new()),
+        };
+        f(&inner, r)
+    }
+
     /// J(p) over `plate` past `sphere`: (the cone subtraction if it answers, the lines at order
     /// 20, the unshadowed J), or `None` where the cone subtraction does not answer.
     fn past_sphere(
@@ -715,28 +743,13 @@ mod tests {
         p: Vec3<f64>,
         np: Vec3<f64>,
     ) -> Option<(f64, f64, f64)> {
-        let b = Patch::whole(plate).unwrap();
-        let count = core::cell::Cell::new(0u64);
-        let inner = Inner {
-            surface: plate,
-            r: b.rect(),
-            rule: GaussRule::<f64>::new(20).unwrap(),
-            probes: 43,
-            affine: plate.affine_map(),
-            trigonometric: false,
-            outline: None,
-            line_rule: GaussRule::<f64>::new(20).unwrap(),
-            use_occluders: true,
-            occluders: sphere,
-            count: &count,
-            scratch: core::cell::RefCell::new(LineScratch::new()),
-            signature_line: core::cell::RefCell::new(Line::new()),
-        };
-        let ball = Ball { center: sphere.center(), radius: sphere.radius() };
-        let closed = inner.point_past_sphere(p, np, &ball)?;
-        let lines = inner.refined(p, np, b.rect(), 0).unwrap();
-        let unshadowed = inner.point_to_polygon(p, np).unwrap_or(1.0).max(1e-300);
-        Some((closed, lines, unshadowed))
+        at_order_20(plate, sphere, true, |inner, r| {
+            let ball = Ball { center: sphere.center(), radius: sphere.radius() };
+            let closed = inner.point_past_sphere(p, np, &ball)?;
+            let lines = inner.refined(p, np, r, 0).unwrap();
+            let unshadowed = inner.point_to_polygon(p, np).unwrap_or(1.0).max(1e-300);
+            Some((closed, lines, unshadowed))
+        })
     }
 
     /// A sphere whose cone of directions from p covers all of a square but thin slivers at its
@@ -790,26 +803,11 @@ mod tests {
     /// J(p) over `plate` with nothing between: (the point-to-polygon form if it answers, the
     /// lines at order 20, the solid angle `plate` subtends facing p squarely), or `None`.
     fn in_front(plate: &Parallelogram<f64>, p: Vec3<f64>, np: Vec3<f64>) -> Option<(f64, f64, f64)> {
-        let b = Patch::whole(plate).unwrap();
-        let count = core::cell::Cell::new(0u64);
-        let inner = Inner {
-            surface: plate,
-            r: b.rect(),
-            rule: GaussRule::<f64>::new(20).unwrap(),
-            probes: 43,
-            affine: plate.affine_map(),
-            trigonometric: false,
-            outline: None,
-            line_rule: GaussRule::<f64>::new(20).unwrap(),
-            use_occluders: false,
-            occluders: &(),
-            count: &count,
-            scratch: core::cell::RefCell::new(LineScratch::new()),
-            signature_line: core::cell::RefCell::new(Line::new()),
-        };
-        let closed = inner.point_to_polygon(p, np)?;
-        let lines = inner.refined(p, np, b.rect(), 0).unwrap();
-        Some((closed, lines, inner.reach(p)))
+        at_order_20(plate, &(), false, |inner, r| {
+            let closed = inner.point_to_polygon(p, np)?;
+            let lines = inner.refined(p, np, r, 0).unwrap();
+            Some((closed, lines, inner.reach(p)))
+        })
     }
 
     /// J(p) past one sphere by the cone subtraction ([`Inner::point_past_sphere`]) against the
