@@ -574,8 +574,15 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
         // Whether each piece of P's boundary lies in C, piece by piece around P: C's boundary is
         // crossed where that changes, also at a vertex of P that lies on it (rounding there
         // can put the edge's root just outside the edge).
-        let mut walk = Crossings { visible: T::ZERO, magnitude: T::ZERO, first_entry: None, pending_exit: None };
-        let (mut entries, mut exits, mut outside) = (0usize, 0usize, false);
+        let mut walk = Crossings {
+            visible: T::ZERO,
+            magnitude: T::ZERO,
+            entries: 0,
+            exits: 0,
+            first_entry: None,
+            pending_exit: None,
+        };
+        let mut outside = false;
         let (mut previous, mut first): (Option<bool>, Option<bool>) = (None, None);
         for (j, &a) in used.iter().enumerate() {
             let Some(&b) = used.get((j + 1) % n) else { continue };
@@ -605,7 +612,6 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
                 let (u, v) = (da + e.scale(lo), da + e.scale(hi));
                 let now = inside(da + e.scale((lo + hi) * T::HALF));
                 if previous == Some(!now) {
-                    *(if now { &mut entries } else { &mut exits }) += 1;
                     walk.cross(now, angle(u), &circle);
                 }
                 previous = Some(now);
@@ -621,14 +627,13 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
         // Around the last vertex back to the first.
         if let (Some(last), Some(now), Some(&a)) = (previous, first, used.first()) {
             if last != now {
-                *(if now { &mut entries } else { &mut exits }) += 1;
                 walk.cross(now, angle(a - p), &circle);
             }
         }
+        let Crossings { mut visible, mut magnitude, entries, exits, first_entry, pending_exit } = walk;
         if entries != exits {
             return None;
         }
-        let Crossings { mut visible, mut magnitude, first_entry, pending_exit } = walk;
         if !outside && entries == 0 {
             // P lies wholly inside C: b is hidden from p.
             return Some(T::ZERO);
@@ -860,19 +865,24 @@ fn arc<T: Real>(np: Vec3<T>, a: Vec3<T>, b: Vec3<T>) -> (T, T) {
 struct Crossings<T> {
     visible: T,
     magnitude: T,
+    entries: usize,
+    exits: usize,
     first_entry: Option<(T, T)>,
     pending_exit: Option<(T, T)>,
 }
 
 #[cfg(feature = "closed-form")]
 impl<T: Real> Crossings<T> {
-    /// C's boundary crossed at the angle `at` about its axis, into C (`entering`) or out of it;
-    /// `circle(from, to)` is the term of C's circle from one angle to the other.
+    /// C's boundary crossed at the direction `at` about its axis ((cos ψ, sin ψ)), into C
+    /// (`entering`) or out of it; `circle(from, to)` is the term of C's circle from one
+    /// direction to the other.
     fn cross(&mut self, entering: bool, at: (T, T), circle: &dyn Fn((T, T), (T, T)) -> T) {
         if !entering {
+            self.exits += 1;
             self.pending_exit = Some(at);
             return;
         }
+        self.entries += 1;
         match self.pending_exit.take() {
             Some(exit) => {
                 let term = circle(exit, at);
