@@ -4,10 +4,18 @@
 //! `cargo bench -p pdm-host --bench pair -- --warm-up-time 1 --measurement-time 3`
 //!
 //! Cases (closed forms from `pdm_host::reference::closed_form`, `../shared/REFERENCES.md`):
-//! - `c14`: perpendicular unit squares sharing an edge (C-14, F = 0.2000437760754…): the
-//!   contour form, and the edge transform (`touching_exchange`, 6·p⁴ kernel evaluations) it
-//!   replaced for flat pairs;
-//! - `c11`: parallel unit squares at distance 1 (C-11);
+//! the four flat pairs of issue 12's comparison with NIST View3D (a unit floor square
+//! [0,1]² at z = 0 against)
+//! - `c11`: the parallel unit square at distance 1 (C-11);
+//! - `c14`: the perpendicular unit square sharing an edge (C-14, F = 0.2000437760754…); also
+//!   by the edge transform (`touching_exchange`, 6·p⁴ kernel evaluations) that the contour
+//!   form replaced for flat pairs (`c14/edge-transform`);
+//! - `corner`: the wall square x ∈ [1, 2], z ∈ [0, 1] in the plane y = 1, sharing only the
+//!   corner (1, 1, 0) (view-factor algebra on C-14: F(l = 2) − F(l = 1));
+//! - `skew`: a unit square tilted 30° about a diagonal axis above it, no two edges parallel
+//!   (corners below; reference: the host's independent contour integral
+//!   `reference::contour::polygon_form_factor`, which an mpmath computation at 35 digits
+//!   confirms to 1e-16);
 //! - `c41`: coaxial unit disks 0.01 apart, whole (C-41; cut into 4 × 4 piece pairs, the contour
 //!   form along the curved edges);
 //! - `c14-back-to-back`: C-14's squares with the wall radiating away from the floor (exactly 0).
@@ -20,57 +28,95 @@
 //!   1 (the C-41 algebra, F(disk → disk at 0.1) − F(disk → disk at 1.1)); the inner integral over
 //!   the disk by the point form along its outline.
 //!
-//! The relative errors are printed once per case before timing. Single-threaded.
+//! The relative errors and evaluation counts are printed once per case before timing.
+//! Single-threaded.
 
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
 
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use pdm_host::reference::closed_form::{coaxial_disks, parallel_rectangles};
+use pdm_host::reference::closed_form::{coaxial_disks, parallel_rectangles, perpendicular_rectangles};
+use pdm_host::reference::contour::polygon_form_factor;
 use pdm_kernel::internals::{classify_near, touching_exchange};
-use pdm_kernel::{pair_exchange, vec3, Disk, PairSettings, Parallelogram, Patch};
+use pdm_kernel::{pair_exchange, vec3, Disk, PairSettings, Parallelogram, Patch, Quadrilateral};
 
-const C14: f64 = 0.200_043_776_075_403_16;
+/// The skew square's corners (counter-clockwise about its normal, which faces the floor).
+const SKEW: [[f64; 3]; 4] = [
+    [0.1, -0.1, 1.2],
+    [0.16698729810778068, 0.8330127018922193, 0.8464466094067262],
+    [1.1, 0.9, 1.2],
+    [1.0330127018922193, -0.033012701892219325, 1.5535533905932737],
+];
 
 fn settings(order: usize) -> PairSettings {
     PairSettings { order, singular_order: order, boundaries: true }
 }
 
 fn bench_pairs(c: &mut Criterion) {
-    let floor = Parallelogram::new(vec3(0.0, 0.0, 0.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0)).unwrap();
+    let quad = |p: [[f64; 3]; 4]| Quadrilateral::new(p.map(|[x, y, z]| vec3(x, y, z))).unwrap();
+    let floor_corners = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
+    let floor = quad(floor_corners);
+    let walls = [
+        (
+            "c11",
+            [[0.0, 0.0, 1.0], [0.0, 1.0, 1.0], [1.0, 1.0, 1.0], [1.0, 0.0, 1.0]],
+            parallel_rectangles(1.0, 1.0, 1.0),
+        ),
+        (
+            "c14",
+            [[0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 1.0], [1.0, 0.0, 0.0]],
+            perpendicular_rectangles(1.0, 1.0, 1.0),
+        ),
+        (
+            "corner",
+            [[1.0, 1.0, 0.0], [2.0, 1.0, 0.0], [2.0, 1.0, 1.0], [1.0, 1.0, 1.0]],
+            perpendicular_rectangles(2.0, 1.0, 1.0) - perpendicular_rectangles(1.0, 1.0, 1.0),
+        ),
+        ("skew", SKEW, polygon_form_factor(&floor_corners, &SKEW)),
+    ];
+    let pf = Patch::whole(&floor).unwrap();
+    let mut group = c.benchmark_group("pair");
+    for (name, corners, exact) in walls {
+        let wall = quad(corners);
+        let pw = Patch::whole(&wall).unwrap();
+        for order in [2, 3, 4, 6, 8] {
+            if name != "skew" && order != 2 && order != 8 {
+                continue;
+            }
+            let e = pair_exchange::<f64, _, _, _, 64>(&pf, &pw, settings(order), &()).unwrap();
+            eprintln!(
+                "{name} order {order}: relative error {:.1e}, {} evaluations",
+                (e.value - exact).abs() / exact,
+                e.evaluations
+            );
+            let s = settings(order);
+            group.bench_with_input(BenchmarkId::new(name, order), &order, |bench, _| {
+                bench.iter(|| pair_exchange::<f64, _, _, _, 64>(black_box(&pf), black_box(&pw), s, &()).unwrap().value);
+            });
+        }
+    }
+    // The edge transform the contour form replaced, on C-14.
+    let square = Parallelogram::new(vec3(0.0, 0.0, 0.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0)).unwrap();
     let wall = Parallelogram::new(vec3(0.0, 0.0, 0.0), vec3(0.0, 0.0, 1.0), vec3(1.0, 0.0, 0.0)).unwrap();
-    let top = Parallelogram::new(vec3(0.0, 0.0, 1.0), vec3(0.0, 1.0, 0.0), vec3(1.0, 0.0, 0.0)).unwrap();
+    let (ps, pw) = (Patch::whole(&square).unwrap(), Patch::whole(&wall).unwrap());
+    let (adjacency, gap) = classify_near(&ps, &pw);
+    let c14 = perpendicular_rectangles(1.0, 1.0, 1.0);
+    for order in [8, 12] {
+        let transform = touching_exchange(&ps, &pw, adjacency, gap, order, &()).unwrap();
+        eprintln!("c14 edge transform order {order}: relative error {:.1e}", (transform - c14).abs() / c14);
+        group.bench_with_input(BenchmarkId::new("c14/edge-transform", order), &order, |bench, _| {
+            bench.iter(|| touching_exchange(black_box(&ps), black_box(&pw), adjacency, gap, order, &()).unwrap());
+        });
+    }
     let lower = Disk::new(vec3(0.0, 0.0, 0.0), vec3(0.0, 0.0, 1.0), 1.0).unwrap();
     let upper = Disk::new(vec3(0.0, 0.0, 0.01), vec3(0.0, 0.0, -1.0), 1.0).unwrap();
-    let (pf, pw, pt) = (Patch::whole(&floor).unwrap(), Patch::whole(&wall).unwrap(), Patch::whole(&top).unwrap());
     let (pl, pu) = (Patch::whole(&lower).unwrap(), Patch::whole(&upper).unwrap());
-    let (adjacency, gap) = classify_near(&pf, &pw);
     let disks = std::f64::consts::PI * coaxial_disks(1.0, 1.0, 0.01);
-    let c11 = parallel_rectangles(1.0, 1.0, 1.0);
-    let mut group = c.benchmark_group("pair");
     for order in [8, 12, 16] {
         let s = settings(order);
-        let contour = pair_exchange::<f64, _, _, _, 256>(&pf, &pw, s, &()).unwrap().value;
-        let transform = touching_exchange(&pf, &pw, adjacency, gap, order, &()).unwrap();
-        let parallel = pair_exchange::<f64, _, _, _, 256>(&pf, &pt, s, &()).unwrap().value;
         let coaxial = pair_exchange::<f64, _, _, _, 256>(&pl, &pu, s, &()).unwrap().value;
-        eprintln!(
-            "order {order}: c14 contour {:.1e}, c14 edge transform {:.1e}, c11 {:.1e}, c41 disks at 0.01 {:.1e}",
-            (contour - C14).abs() / C14,
-            (transform - C14).abs() / C14,
-            (parallel - c11).abs() / c11,
-            (coaxial - disks).abs() / disks
-        );
-        group.bench_with_input(BenchmarkId::new("c14/contour", order), &order, |bench, _| {
-            bench.iter(|| pair_exchange::<f64, _, _, _, 256>(black_box(&pf), black_box(&pw), s, &()).unwrap().value);
-        });
-        group.bench_with_input(BenchmarkId::new("c14/edge-transform", order), &order, |bench, _| {
-            bench.iter(|| touching_exchange(black_box(&pf), black_box(&pw), adjacency, gap, order, &()).unwrap());
-        });
-        group.bench_with_input(BenchmarkId::new("c11/contour", order), &order, |bench, _| {
-            bench.iter(|| pair_exchange::<f64, _, _, _, 256>(black_box(&pf), black_box(&pt), s, &()).unwrap().value);
-        });
+        eprintln!("c41 disks at 0.01, order {order}: relative error {:.1e}", (coaxial - disks).abs() / disks);
         group.bench_with_input(BenchmarkId::new("c41-0.01/contour", order), &order, |bench, _| {
             bench.iter(|| pair_exchange::<f64, _, _, _, 256>(black_box(&pl), black_box(&pu), s, &()).unwrap().value);
         });
@@ -79,9 +125,9 @@ fn bench_pairs(c: &mut Criterion) {
     let back = Parallelogram::new(vec3(0.0, 0.0, 0.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 0.0, 1.0)).unwrap();
     let pk = Patch::whole(&back).unwrap();
     let s = settings(8);
-    assert_eq!(pair_exchange::<f64, _, _, _, 256>(&pf, &pk, s, &()).unwrap().value, 0.0);
+    assert_eq!(pair_exchange::<f64, _, _, _, 256>(&ps, &pk, s, &()).unwrap().value, 0.0);
     group.bench_with_input(BenchmarkId::new("c14-back-to-back", 8), &8, |bench, _| {
-        bench.iter(|| pair_exchange::<f64, _, _, _, 256>(black_box(&pf), black_box(&pk), s, &()).unwrap().value);
+        bench.iter(|| pair_exchange::<f64, _, _, _, 256>(black_box(&ps), black_box(&pk), s, &()).unwrap().value);
     });
     group.finish();
     near_flat(c);

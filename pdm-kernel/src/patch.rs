@@ -155,6 +155,22 @@ impl<'s, T: Real, S: Surface<T> + ?Sized> Patch<'s, T, S> {
         Ok(area)
     }
 
+    /// The area for the physical bounds of a pair: half the cross product of the diagonals for
+    /// a flat patch with straight edges ([`Surface::straight_corners`], exact for any flat
+    /// quadrilateral or triangle, and free of the rule's order² normals), else [`Patch::area`]
+    /// at `order`.
+    pub(crate) fn bounds_area(&self, order: usize) -> Result<T, PdmError> {
+        #[cfg(feature = "closed-form")]
+        if let Some([c0, c1, c2, c3]) = self.surface.straight_corners(self.rect) {
+            let area = (c2 - c0).cross(c3 - c1).norm() * T::HALF;
+            if !area.is_finite() {
+                return Err(PdmError::NonFinite);
+            }
+            return if area > T::ZERO { Ok(area) } else { Err(PdmError::Degenerate) };
+        }
+        self.area(order)
+    }
+
     /// The m × n grid of sub-patches of this patch (m along t, n along s), as an iterator.
     pub fn grid(&self, m: usize, n: usize) -> Result<PatchGrid<'s, T, S>, PdmError> {
         PatchGrid::over(self.surface, self.rect, m, n)

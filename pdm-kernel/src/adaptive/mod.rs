@@ -245,7 +245,7 @@ where
         e.add(recurse::<T, SA, SB, O, CAP>(pa, pb, work, occluders, 0)?);
         Ok(())
     })?;
-    let (area_a, area_b) = (a.area(settings.max_order)?, b.area(settings.max_order)?);
+    let (area_a, area_b) = (a.bounds_area(settings.max_order)?, b.bounds_area(settings.max_order)?);
     // The leaves are unchecked approximations: the total may overshoot [0, min(A_a, A_b)] by
     // its error, and is clamped there; beyond its error it is refused.
     e.value = crate::bounds::exchange_within(e.value, e.error, area_a, area_b)?;

@@ -20,7 +20,12 @@
 //! passes either end of edge b (u₀ = 0, u₀ = L) and where the two lines come closest. The outer
 //! rule is split there and cut geometrically towards each such point down to that distance
 //! (widths d, 4d, 16d, …), so it converges exponentially in the order for every gap.
-//! Perpendicular edges contribute nothing (d_a·d_b = 0). The geometry is translated to its
+//! Perpendicular edges contribute nothing (d_a·d_b = 0). Two kinds of edge pairs need no
+//! outer rule at all, and they are the ones where it would cut geometrically down to rounding:
+//! parallel edges (collinear ones included: a shared edge) and edges leaving a common end (a
+//! shared corner) have the whole double integral in closed form (`quad.rs`:
+//! `closed_edge_pair`), so C-11, C-14 and squares sharing a corner cost 16–32 closed-form
+//! terms at any order. The geometry is translated to its
 //! centroid and scaled to unit size first (the ln of the scale integrates to zero over a closed
 //! contour), so the logarithms stay O(1) at any scale.
 //!

@@ -50,7 +50,7 @@ pub(crate) fn quad_exchange<T: Real>(
             if dot.abs() <= T::EPSILON * da.norm() * db.norm() {
                 continue;
             }
-            let (v, m, n) = edge_pair(&rule, p0, da, q0, db);
+            let (v, m, n) = closed_edge_pair(p0, da, q0, db).unwrap_or_else(|| edge_pair(&rule, p0, da, q0, db));
             total += dot * v;
             magnitude += dot.abs() * m;
             evaluations = evaluations.saturating_add(n);
@@ -116,6 +116,87 @@ pub(super) fn edge_pair<T: Real>(rule: &GaussRule<T>, p: Vec3<T>, da: Vec3<T>, q
         lo = hi;
     }
     (total.0, total.1, evaluations)
+}
+
+/// Edge pairs whose double integral is elementary: parallel edges (collinear ones included)
+/// and edges meeting at a common end, as ([`edge_pair`]'s value, magnitude, evaluations — one
+/// per closed-form term). `None` for the others, and where the closed form's terms cancel by
+/// more than [`CLOSED_CANCELLATION`] (an edge short against its distance from the other: the
+/// terms are differences of nearly equal values there, while the graded rule keeps the digits).
+pub(super) fn closed_edge_pair<T: Real>(p: Vec3<T>, da: Vec3<T>, q: Vec3<T>, db: Vec3<T>) -> Option<(T, T, u64)> {
+    let (len_a, len_b) = (da.norm(), db.norm());
+    let tiny = T::from_f64(16.0) * T::EPSILON;
+    let (value, magnitude, terms) = if da.cross(db).norm() <= tiny * len_a * len_b {
+        parallel_edges(p, da, len_a, q, db, len_b)
+    } else {
+        // A common end, and each edge as a vector away from it.
+        let touch = tiny * len_a.max(len_b);
+        let ends = [(p, da), (p + da, -da)];
+        let (a, b) = ends.iter().find_map(|&(x, a)| {
+            [(q, db), (q + db, -db)].iter().find_map(|&(y, b)| ((x - y).norm() <= touch).then_some((a, b)))
+        })?;
+        edges_from_one_point(a, len_a, b, len_b)
+    };
+    (value.is_finite() && magnitude <= T::from_f64(CLOSED_CANCELLATION) * value.abs())
+        .then_some((value, magnitude, terms))
+}
+
+/// Largest ratio of the closed form's term magnitudes to its value that [`closed_edge_pair`]
+/// accepts (2.4 digits: the catalogue's squares, sharing edges or corners or facing, reach 58).
+const CLOSED_CANCELLATION: f64 = 256.0;
+
+/// ∫₀¹∫₀¹ ln |x(σ) − y(τ)| for parallel edges: with u along b's direction, x(σ) runs over
+/// u ∈ [u₀, u₁] at the constant distance h from b's line, y over [0, L_b], and
+///
+/// ∫∫ ln((u − v)² + h²) du dv = K(u₁) + K(u₀ − L_b) − K(u₁ − L_b) − K(u₀),
+/// K(w) = ½(w² − h²) ln(w² + h²) − 3w²/2 + 2hw atan(w/h)  (K″ = ln(w² + h²), K′ = G),
+///
+/// divided by 2(u₁ − u₀)L_b; the polynomial part −3w²/2 sums to −3(u₁ − u₀)L_b exactly. Two identical collinear edges of length L give
+/// L²(ln L² − 3)/(2L²) (`../shared/REFERENCES.md`).
+fn parallel_edges<T: Real>(p: Vec3<T>, da: Vec3<T>, len_a: T, q: Vec3<T>, db: Vec3<T>, len_b: T) -> (T, T, u64) {
+    let e = db.scale(T::ONE / len_b);
+    let w = p - q;
+    let h = w.cross(e).norm();
+    let (f0, f1) = (w.dot(e), da.dot(e));
+    let (u0, u1) = if f1 < T::ZERO { (f0 + f1, f0) } else { (f0, f0 + f1) };
+    let terms = [big_k(u1, h), big_k(u0 - len_b, h), -big_k(u1 - len_b, h), -big_k(u0, h)];
+    let scale = T::ONE / (T::TWO * len_a * len_b);
+    let (sum, magnitude) = terms.iter().fold((T::ZERO, T::ZERO), |(s, m), &k| (s + k, m + k.abs()));
+    // K's polynomial part −3w²/2 sums to −3(u₁ − u₀)L_b exactly: −3/2 after the scale.
+    let poly = T::from_f64(1.5);
+    (sum * scale - poly, magnitude * scale + poly, 4)
+}
+
+/// ∫₀¹∫₀¹ ln |σa − τb| for edges a, b leaving one point at an angle θ (cos θ = c,
+/// sin θ = s, s > 0), lengths A, B. Splitting [0, A] × [0, B] along its diagonal, each triangle is
+/// ρ ↦ (ρ, ρvβ) (β = B/A) or its mirror, and ln(p² + q² − 2pqc) = 2 ln ρ + ln((βv − c)² + s²)
+/// separates:
+///
+/// I = (ln(AB) − 1)/2 + (M(B/A) + M(A/B))/4,  M(β) = ∫₀¹ ln((βv − c)² + s²) dv
+///   = [G(β − c) − G(−c)]/β  (G at η = s).
+fn edges_from_one_point<T: Real>(a: Vec3<T>, len_a: T, b: Vec3<T>, len_b: T) -> (T, T, u64) {
+    let ab = len_a * len_b;
+    let (c, s) = (a.dot(b) / ab, a.cross(b).norm() / ab);
+    let g0 = big_g(-c, s);
+    let m = |beta: T| {
+        let g1 = big_g(beta - c, s);
+        ((g1 - g0) / beta, (g1.abs() + g0.abs()) / beta)
+    };
+    let (m1, m2) = (m(len_b / len_a), m(len_a / len_b));
+    let quarter = T::HALF * T::HALF;
+    let log = (ab.ln() - T::ONE) * T::HALF;
+    (log + (m1.0 + m2.0) * quarter, log.abs() + (m1.1 + m2.1) * quarter, 3)
+}
+
+/// K(w) + 3w²/2 = ½(w² − h²) ln(w² + h²) + 2hw atan(w/h) (K = ∫ G up to a constant; its
+/// polynomial part is summed exactly by the caller).
+#[inline]
+pub(super) fn big_k<T: Real>(w: T, h: T) -> T {
+    let (w2, h2) = (w * w, h * h);
+    let r2 = w2 + h2;
+    let log_term = if r2 > T::ZERO { (w2 - h2) * T::HALF * r2.ln() } else { T::ZERO };
+    let angle = if h > T::ZERO { T::TWO * h * w * (w / h).atan() } else { T::ZERO };
+    log_term + angle
 }
 
 /// G(v) = ∫ ln(v² + η²) dv = v ln(v² + η²) − 2v + 2η atan(v/η) (0 at v = 0).

@@ -239,3 +239,65 @@ fn triangles_and_quadrilaterals_match_their_bezier_nets() {
         }
     }
 }
+
+/// The edge pairs in closed form ([`closed_edge_pair`]: parallel, and from one point) against
+/// known integrals and against the graded rule with the closed-form inner integral
+/// ([`edge_pair`] at order 24) on pseudo-random placements: collinear overlapping, collinear
+/// apart, parallel at any offset, either direction; edges leaving a common end at any angle,
+/// whichever ends they share.
+#[test]
+fn closed_edge_pairs_match_known_integrals_and_the_graded_rule() {
+    use crate::vec3::vec3;
+    let (o, x, y) = (vec3(0.0, 0.0, 0.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0));
+    // ∫₀¹∫₀¹ ln |s − s′| = −3/2; ∫₀¹∫₀¹ ½ ln(s² + s′²) = (ln 2 − 3 + π/2)/2.
+    let same = closed_edge_pair(o, x, o, x).unwrap().0;
+    assert!((same + 1.5).abs() < 1e-15, "{same}");
+    let right = closed_edge_pair(o, x, o, y).unwrap().0;
+    let exact = (2f64.ln() - 3.0 + core::f64::consts::FRAC_PI_2) / 2.0;
+    assert!((right - exact).abs() < 1e-15, "{right} vs {exact}");
+    // Skew and crossing edges have no closed form here.
+    assert!(closed_edge_pair(o, x, vec3(0.5, -0.5, 0.3), y).is_none());
+    assert!(closed_edge_pair(o, x, vec3(0.5, -0.5, 0.0), y).is_none());
+
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut next = || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+    };
+    let rule = GaussRule::<f64>::new(24).unwrap();
+    let (mut parallel, mut pointed) = (0, 0);
+    for case in 0..400 {
+        let p = vec3(next(), next(), next());
+        let da = vec3(next(), next(), next());
+        let (q, db) = if case % 2 == 0 {
+            // Parallel: b along ±da, offset anywhere (a quarter of them on a's line).
+            let along = da.scale(next() * 1.5);
+            let off = if case % 8 == 0 { da.scale(next() * 2.0) } else { vec3(next(), next(), next()) };
+            (p + off, if along.norm() > 1e-3 { along } else { da })
+        } else {
+            // From one point: b starts or ends where a starts or ends.
+            let db = vec3(next(), next(), next());
+            let start = if case % 4 == 1 { p } else { p + da };
+            if case % 3 == 0 {
+                (start, db)
+            } else {
+                (start - db, db)
+            }
+        };
+        let Some((closed, magnitude, _)) = closed_edge_pair(p, da, q, db) else { continue };
+        if case % 2 == 0 {
+            parallel += 1;
+        } else {
+            pointed += 1;
+        }
+        let (graded, _, _) = edge_pair(&rule, p, da, q, db);
+        assert!(
+            (closed - graded).abs() < 1e-14 * magnitude.max(1.0),
+            "case {case}: {closed} vs {graded} (magnitude {magnitude})"
+        );
+    }
+    // The cancellation limit refuses only short edges far from the other.
+    assert!(parallel > 150 && pointed > 150, "{parallel} parallel, {pointed} from one point");
+}

@@ -5,11 +5,10 @@ use super::*;
 
 /// Whether a pair of the given contact may take the contour form (if both patches are flat
 /// and see each other wholly, [`flat_pair`]): separate, nearly touching and touching pairs —
-/// along a shared edge the collinear edge term is the closed form at η = 0, whose logarithm
-/// the outer rule's grading towards the edge's ends integrates (C-14 at order 12 to 3e-16 with
-/// 672 line evaluations, where the edge transform needs 6·p⁴), and a partial shared edge (a
-/// short edge lying along a longer one from a common corner, a non-conforming grid) is
-/// covered the same way. The same patch twice takes the identical-panel transform.
+/// along a shared edge the collinear edge pair and at a shared corner the edges leaving it
+/// are in closed form (C-14 exact with 16 terms, where the edge transform needs 6·p⁴
+/// evaluations), and a partial shared edge (a short edge lying along a longer one from a
+/// common corner, a non-conforming grid) is a collinear pair too. The same patch twice takes the identical-panel transform.
 #[cfg(feature = "closed-form")]
 pub(crate) fn contour_applies(adjacency: Adjacency) -> bool {
     adjacency != Adjacency::Identical
@@ -66,10 +65,14 @@ where
         (FlatShape::Outlines(oa, ob), b_ahead, a_ahead, cos)
     };
     if b_ahead && a_ahead {
-        if occluders.may_block_between(&a.enclosing_ball(), &b.enclosing_ball()) {
+        let balls = match &shape {
+            FlatShape::Corners(ca, cb) => (corner_ball(ca), corner_ball(cb)),
+            FlatShape::Outlines(..) => (a.enclosing_ball(), b.enclosing_ball()),
+        };
+        if occluders.may_block_between(&balls.0, &balls.1) {
             return None;
         }
-        let order = order.max(4);
+        let order = order.max(2);
         return Some(match shape {
             FlatShape::Corners(ca, cb) => crate::contour::quad_exchange(&ca, &cb, order),
             FlatShape::Outlines(oa, ob) => crate::contour::curve_exchange(&oa, &ob, order),
@@ -79,6 +82,17 @@ where
     // below the geometry's resolution (f32 plates 1e-6 apart), which no path can integrate
     // (the 4-D rules would return a value off by percents).
     (!b_ahead && !a_ahead && cos < T::ZERO).then_some(Err(PdmError::Unresolvable))
+}
+
+/// The ball about a convex polygon's corners that holds it: centred at their mean, through the
+/// farthest, widened by 1/8 as [`Patch::enclosing_ball`] is (the culling tests treat it as a
+/// bound, and the corners' rounding must stay inside).
+#[cfg(feature = "closed-form")]
+fn corner_ball<T: Real>(corners: &[Vec3<T>; 4]) -> crate::vec3::Ball<T> {
+    let [c0, c1, c2, c3] = *corners;
+    let center = (c0 + c1 + c2 + c3).scale(T::HALF * T::HALF);
+    let radius = corners.iter().fold(T::ZERO, |r, &c| r.max((c - center).norm()));
+    crate::vec3::Ball { center, radius: radius * (T::ONE + T::from_f64(0.125)) }
 }
 
 /// The two flat patches of [`flat_pair`]: parallelograms by their corners (inner line

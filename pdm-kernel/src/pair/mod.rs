@@ -204,7 +204,7 @@ where
     // (which can only be closer to the true value); farther out the method is wrong for the
     // pair and the value is refused.
     let band = value.abs() * T::from_f64(QUADRATURE_BAND);
-    let value = crate::bounds::exchange_within(value, band, a.area(order)?, b.area(order)?)?;
+    let value = crate::bounds::exchange_within(value, band, a.bounds_area(order)?, b.bounds_area(order)?)?;
     Ok(Estimate::fixed(value, count))
 }
 
@@ -273,11 +273,21 @@ where
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
+    // The contour form first: most flat pairs end here, before the classification and the
+    // sample buffers below (which only its refusals need).
+    #[cfg(feature = "closed-form")]
+    let flat = if settings.boundaries { flat_pair(a, b, settings.order, occluders) } else { None };
+    #[cfg(feature = "closed-form")]
+    if let Some(Ok((v, c, r))) = flat {
+        if !crate::bounds::lost_digits(v, r) && !crate::bounds::cancels(v, r) {
+            return Ok(Some((v, c, r)));
+        }
+    }
     let (adjacency, gap) = classify_near(a, b);
     let mut pair = PairContext::<T, SA, SB, O, CAP>::new(a, b, occluders);
     #[cfg(feature = "closed-form")]
-    if settings.boundaries && contour_applies(adjacency) {
-        match flat_pair(a, b, settings.order, occluders) {
+    if contour_applies(adjacency) {
+        match flat {
             // A touching pair whose contour terms cancel beyond the working precision, or
             // below the geometry's resolution: the transforms below take it.
             Some(Err(PdmError::Unresolvable)) if adjacency != Adjacency::Separate => {}

@@ -41,6 +41,11 @@ where
 pub(crate) fn pieces<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>) -> (usize, usize) {
     let r = p.rect();
     let g = p.surface();
+    // A flat patch with straight edges cannot close on itself.
+    #[cfg(feature = "closed-form")]
+    if g.straight_corners(r).is_some() {
+        return (1, 1);
+    }
     let (tm, sm) = ((r.t0 + r.t1) * T::HALF, (r.s0 + r.s1) * T::HALF);
     let count = |chord: T, arc: T| -> usize {
         if !(arc > T::ZERO) || !chord.is_finite() || !arc.is_finite() {
