@@ -3,7 +3,8 @@
 
 use super::*;
 
-/// The contour form ([`crate::pair::flat_pair`]) at orders `lo_order`, 2·`lo_order`, then up
+/// The contour form ([`crate::pair::flat_pair`]) at `lo_order`; where every edge pair was in
+/// closed form that value stands with its rounding bound, otherwise orders 2·`lo_order`, then up
 /// by 8 to [`MAX_ORDER`](crate::MAX_ORDER) until the difference between the last two plus the
 /// rounding bound, the estimate, meets the tolerance. Its rules are 1-D (cost ∝ p², no sample
 /// buffers), so `max_order`, which bounds the 4-D rules, does not limit them. With the
@@ -24,13 +25,19 @@ where
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
-    let (mut lo, mut evaluations, _) = match crate::pair::flat_pair(a, b, lo_order, occluders)? {
+    let (mut lo, mut evaluations, rounding, exact) = match crate::pair::flat_pair(a, b, lo_order, occluders)? {
         Ok(x) => x,
         Err(e) => return Some(Err(e)),
     };
+    // Every edge pair in closed form: the value is the same at every order, its error the
+    // rounding alone.
+    if exact {
+        let estimate = Tally::leaf(lo, rounding, settings.tolerance, evaluations);
+        return Some(Ok((estimate, crate::bounds::lost_digits(lo, rounding))));
+    }
     let mut order = 2 * lo_order;
     loop {
-        let (hi, n, rounding) = match crate::pair::flat_pair(a, b, order, occluders)? {
+        let (hi, n, rounding, _) = match crate::pair::flat_pair(a, b, order, occluders)? {
             Ok(x) => x,
             Err(e) => return Some(Err(e)),
         };

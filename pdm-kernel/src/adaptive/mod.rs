@@ -52,9 +52,10 @@
 //!   (d₂ alone on a separate pair's first comparison, whose start order the geometry chose);
 //!   touching pairs compare at least three orders. The geometric mean covers convergence that
 //!   stalls for a step (checked against closed forms and the contour integral in the tests).
-//! * Flat pairs by the contour form: the difference between orders 8 and 16 (then 24, 32
-//!   until it meets the tolerance: the contour's 1-D rules are not bound by `max_order`) plus
-//!   the bound on the rounding of the cancelling terms.
+//! * Flat pairs by the contour form: where every edge pair is in closed form (parallel edges,
+//!   edges from a common corner), the bound on the rounding of the cancelling terms alone;
+//!   otherwise the difference between orders 8 and 16 (then 24, 32 until it meets the
+//!   tolerance: the contour's 1-D rules are not bound by `max_order`) plus that bound.
 //! * Pairs across visibility boundaries whose outer events are placed into the outer rule
 //!   (`boundary/`: a flat outer patch against a parallelogram across one sphere, or against a
 //!   sphere's cell; a sphere's cell against a parallelogram): they converge exponentially, and are estimated as smooth pairs by order

@@ -6,8 +6,9 @@ use super::*;
 /// Most geometric cuts towards one singular point (4^24 ≈ 3e14: any gap above rounding).
 pub(super) const MAX_LEVELS: usize = 26;
 
-/// A_a·F_{a→b}, the number of line-integrand evaluations and a bound on the rounding error of
-/// the value, for two flat convex quadrilaterals
+/// A_a·F_{a→b}, the number of line-integrand evaluations, a bound on the rounding error of
+/// the value, and whether every edge pair was in closed form (no rule: the value is exact to
+/// that bound at any order), for two flat convex quadrilaterals
 /// given by their corners in order, counter-clockwise about their radiating normals, each
 /// wholly in front of (or on) the other's plane and with no occluder between them.
 ///
@@ -19,7 +20,7 @@ pub(crate) fn quad_exchange<T: Real>(
     a: &[Vec3<T>; 4],
     b: &[Vec3<T>; 4],
     order: usize,
-) -> Result<(T, u64, T), PdmError> {
+) -> Result<(T, u64, T, bool), PdmError> {
     let rule = GaussRule::<T>::new(order)?;
     // Centroid to the origin, largest distance to 1.
     let mut centroid = crate::vec3::vec3(T::ZERO, T::ZERO, T::ZERO);
@@ -40,6 +41,7 @@ pub(crate) fn quad_exchange<T: Real>(
     let mut total = T::ZERO;
     let mut magnitude = T::ZERO;
     let mut evaluations = 0u64;
+    let mut exact = true;
     // Each edge as (start, vector, length).
     let edges = |u: &[Vec3<T>; 4]| {
         let [c0, c1, c2, c3] = *u;
@@ -52,8 +54,10 @@ pub(crate) fn quad_exchange<T: Real>(
             if dot.abs() <= T::EPSILON * len_a * len_b {
                 continue;
             }
-            let (v, m, n) = closed_edge_pair(p0, da, len_a, q0, db, len_b)
-                .unwrap_or_else(|| edge_pair(&rule, p0, da, len_a, q0, db, len_b));
+            let (v, m, n) = closed_edge_pair(p0, da, len_a, q0, db, len_b).unwrap_or_else(|| {
+                exact = false;
+                edge_pair(&rule, p0, da, len_a, q0, db, len_b)
+            });
             total += dot * v;
             magnitude += dot.abs() * m;
             evaluations = evaluations.saturating_add(n);
@@ -64,7 +68,7 @@ pub(crate) fn quad_exchange<T: Real>(
     }
     let rounding = T::from_f64(8.0) * T::EPSILON * magnitude;
     let scale = size * size * T::FRAC_1_PI * T::HALF;
-    Ok((total * scale, evaluations, rounding * scale))
+    Ok((total * scale, evaluations, rounding * scale, exact))
 }
 
 /// Distance (in lengths of the outer edge) within which a singular point of the outer integrand

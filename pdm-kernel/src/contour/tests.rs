@@ -24,7 +24,7 @@ mod forms {
         for h in [1.0, 1e-1, 1e-3, 1e-6, 1e-8] {
             let lower = [vec3(0.0, 0.0, 0.0), vec3(1.0, 0.0, 0.0), vec3(1.0, 1.0, 0.0), vec3(0.0, 1.0, 0.0)];
             let upper = [vec3(0.0, 0.0, h), vec3(0.0, 1.0, h), vec3(1.0, 1.0, h), vec3(1.0, 0.0, h)];
-            let (f, _, _) = quad_exchange::<f64>(&lower, &upper, 10).unwrap();
+            let (f, _, _, _) = quad_exchange::<f64>(&lower, &upper, 10).unwrap();
             let exact = c11(h);
             // The closed form's terms grow like 1/h² and cancel to O(1): it keeps about
             // ε/h² digits less, 1e-10 at h = 1e-8.
@@ -56,7 +56,7 @@ mod forms {
                 let (cl, cu) = (corners(&lower), corners(&upper));
                 // The upper one's corners run clockwise about +z, i.e. counter-clockwise about
                 // its radiating normal (−z, towards the lower one).
-                let (closed, _, _) = quad_exchange::<f64>(&cl, &cu, 16).unwrap();
+                let (closed, _, _, _) = quad_exchange::<f64>(&cl, &cu, 16).unwrap();
                 // Both sum O(1) terms to a value that can be far smaller (8e-4 where the squares
                 // overlap by 1e-3): the quadrature error scales with the terms, as the rounding
                 // bound (8 ε × their magnitude) does.

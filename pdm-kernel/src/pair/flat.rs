@@ -18,15 +18,16 @@ pub(crate) fn contour_applies(adjacency: Adjacency) -> bool {
 /// other, not coplanar, no occluder able to cut a segment between them — by the contour form
 /// ([`crate::contour`]: parallelograms in closed form along the inner edge, curved edges by
 /// graded rules), exponential at any gap and aspect ratio; `None` if the pair is not such a
-/// pair. Gives the value, the evaluations and a bound on the value's rounding error (the
-/// caller refuses values that lost half their digits, [`crate::bounds::lost_digits`]).
+/// pair. Gives the value, the evaluations, a bound on the value's rounding error (the
+/// caller refuses values that lost half their digits, [`crate::bounds::lost_digits`]) and
+/// whether every edge pair was in closed form (the value is then the same at every order).
 #[cfg(feature = "closed-form")]
 pub(crate) fn flat_pair<'p, 'r, T, SA, SB, O>(
     a: &Patch<'p, T, SA>,
     b: &Patch<'r, T, SB>,
     order: usize,
     occluders: &O,
-) -> Option<Result<(T, u64, T), PdmError>>
+) -> Option<Result<(T, u64, T, bool), PdmError>>
 where
     T: Real,
     SA: Surface<T> + ?Sized,
@@ -51,7 +52,7 @@ where
         // beyond the band): no sample pair passes the facing test, the exchange is exactly 0
         // (back-to-back facets of a mesh, touching or not), whatever occludes.
         if b_side == (false, true) || a_side == (false, true) {
-            return Some(Ok((T::ZERO, 0, T::ZERO)));
+            return Some(Ok((T::ZERO, 0, T::ZERO, true)));
         }
         // Each wholly in front of (or on) the other's plane, or not a flat pair.
         let side = |(ahead, behind): (bool, bool)| (!behind).then_some(ahead);
@@ -75,7 +76,9 @@ where
         let order = order.max(2);
         return Some(match shape {
             FlatShape::Corners(ca, cb) => crate::contour::quad_exchange(&ca, &cb, order),
-            FlatShape::Outlines(oa, ob) => crate::contour::curve_exchange(&oa, &ob, order),
+            FlatShape::Outlines(oa, ob) => {
+                crate::contour::curve_exchange(&oa, &ob, order).map(|(v, n, r)| (v, n, r, false))
+            }
         });
     }
     // Each within the other's plane to the working precision while facing each other: a gap

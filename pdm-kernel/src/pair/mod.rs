@@ -276,7 +276,10 @@ where
     // The contour form first: most flat pairs end here, before the classification and the
     // sample buffers below (which only its refusals need).
     #[cfg(feature = "closed-form")]
-    let flat = if settings.boundaries { flat_pair(a, b, settings.order, occluders) } else { None };
+    let flat = settings
+        .boundaries
+        .then(|| flat_pair(a, b, settings.order, occluders).map(|result| result.map(|(v, c, r, _)| (v, c, r))))
+        .flatten();
     #[cfg(feature = "closed-form")]
     if let Some(Ok((v, c, r))) = flat {
         if !crate::bounds::lost_digits(v, r) && !crate::bounds::cancels(v, r) {

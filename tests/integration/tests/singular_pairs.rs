@@ -5,8 +5,8 @@
 use pdm_host::reference::{closed_form as exact, contour};
 use pdm_kernel::internals::{classify, Adjacency};
 use pdm_kernel::{
-    pair_exchange, vec3, Cylinder, Disk, PairSettings, Parallelogram, Patch, PatchGrid, PatchSamples, Quadrilateral,
-    Real, Side, Sphere, Surface, Vec3,
+    adaptive_exchange, pair_exchange, vec3, Adaptive, Cylinder, Disk, PairSettings, Parallelogram, Patch, PatchGrid,
+    PatchSamples, Quadrilateral, Real, Side, Sphere, Surface, Vec3,
 };
 
 fn v<T: Real>(p: [f64; 3]) -> Vec3<T> {
@@ -261,6 +261,20 @@ fn flat_pairs_with_parallel_or_meeting_edges_are_exact_at_the_lowest_order() {
             assert!(evaluations <= 32, "{name}: {evaluations} evaluations, not the closed forms");
             assert!(rel(f32_value, *reference) < allowed_f32, "{name} f32: {f32_value}");
         }
+        // The tolerance mode takes the closed forms once: their value is the same at every
+        // order, and the estimate is their rounding bound, which covers the error.
+        let (a, b) = quads::<f64>(&floor, wall);
+        let (pa, pb) = (Patch::whole(&a).unwrap(), Patch::whole(&b).unwrap());
+        let e = adaptive_exchange::<f64, _, _, _, 256>(&pa, &pb, Adaptive::new(1e-12), &()).unwrap();
+        let (_, fixed) = run(&a, &b, 2);
+        let error = e.error.unwrap();
+        println!(
+            "{name} tolerance 1e-12: error {:.1e}, estimate {error:.1e}, {} evaluations",
+            (e.value - reference).abs(),
+            e.evaluations
+        );
+        assert!(e.converged && (e.value - reference).abs() <= error && error < 1e-13, "{name}: {e:?}");
+        assert_eq!(e.evaluations, fixed, "{name}: the closed forms more than once");
     }
     let skew = [
         [0.1, -0.1, 1.2],
