@@ -71,13 +71,17 @@ pub(crate) fn quad_exchange<T: Real>(
     Ok((total * scale, evaluations, rounding * scale, exact))
 }
 
-/// Distance (in lengths of the outer edge) within which a singular point of the outer integrand
-/// gets a cut. A singularity at distance δ above the middle of the edge costs the uncut rule
-/// ρ = 2δ + √(1 + 4δ²) per node pair; cut there, each half sees it at its end, which gives more
-/// per node below δ ≈ 0.3 and less above (the skew pair of `pdm-host/benches/pair.rs`, whose
-/// singular points all lie 0.5 or more away: 4.3e-7 with 64 evaluations uncut, 3.9e-7 with 84
-/// cut). Closer singular points are cut and graded towards ([`graded_piece`]).
-const CUT_REACH: f64 = 0.3;
+/// Whether a singular point of the outer integrand at distance δ (in lengths of the outer
+/// edge) needs a cut at this order: not where the uncut rule is already exact to rounding. A
+/// singularity at distance δ above the middle of the edge limits the `order`-point rule to
+/// ρ^(−2·order), ρ = 2δ + √(1 + 4δ²); that is below ε where 2·order·ln ρ ≥ −ln ε (f64: beyond
+/// 2.3 edge lengths at order 8, 0.69 at 16). Closer singular points are cut and graded towards
+/// ([`graded_piece`]), so skipping the others saves work without costing accuracy.
+fn needs_cut<T: Real>(delta: T, order: usize) -> bool {
+    let two_delta = delta * T::TWO;
+    let rho = two_delta + (T::ONE + two_delta * two_delta).sqrt();
+    T::TWO * T::from_usize(order) * rho.ln() < -T::EPSILON.ln()
+}
 
 /// ∫₀¹∫₀¹ ln |P + σ d_a − Q − τ d_b| dτ dσ (see the module docs), the same integral of the
 /// magnitudes of the closed form's two terms (what its rounding scales with), and the
@@ -114,13 +118,12 @@ pub(super) fn edge_pair<T: Real>(
     if c11 > T::EPSILON * len_a * len_a {
         add(-c0.dot(c1) / c11);
     }
-    // A cut only where the singularity comes within `CUT_REACH` of a (see there).
+    // A cut only where the uncut rule would not be exact to rounding ([`needs_cut`]).
     let distance = |s: T| segment_distance(p + da.scale(s) - q, db, len_b) / len_a;
-    let reach = T::from_f64(CUT_REACH);
     let mut kept = 0usize;
     for k in 0..nc {
         if let Some(&x) = cuts.get(k) {
-            if distance(x) < reach {
+            if needs_cut(distance(x), rule.order()) {
                 if let Some(slot) = cuts.get_mut(kept) {
                     *slot = x;
                 }
