@@ -3,6 +3,20 @@
 
 use super::*;
 
+/// A straight edge: its start, its vector (start to end) and its length.
+#[derive(Clone, Copy)]
+pub(super) struct Edge<T> {
+    pub(super) start: Vec3<T>,
+    pub(super) vector: Vec3<T>,
+    pub(super) length: T,
+}
+
+impl<T: Real> Edge<T> {
+    pub(super) fn new(start: Vec3<T>, vector: Vec3<T>) -> Self {
+        Self { start, vector, length: vector.norm() }
+    }
+}
+
 /// Most geometric cuts towards one singular point (4^24 ≈ 3e14: any gap above rounding).
 pub(super) const MAX_LEVELS: usize = 26;
 
@@ -42,21 +56,20 @@ pub(crate) fn quad_exchange<T: Real>(
     let mut magnitude = T::ZERO;
     let mut evaluations = 0u64;
     let mut exact = true;
-    // Each edge as (start, vector, length).
     let edges = |u: &[Vec3<T>; 4]| {
         let [c0, c1, c2, c3] = *u;
-        [(c0, c1 - c0), (c1, c2 - c1), (c2, c3 - c2), (c3, c0 - c3)].map(|(p, d)| (p, d, d.norm()))
+        [(c0, c1 - c0), (c1, c2 - c1), (c2, c3 - c2), (c3, c0 - c3)].map(|(p, d)| Edge::new(p, d))
     };
     let (ea, eb) = (edges(&ua), edges(&ub));
-    for &(p0, da, len_a) in &ea {
-        for &(q0, db, len_b) in &eb {
-            let dot = da.dot(db);
-            if dot.abs() <= T::EPSILON * len_a * len_b {
+    for &a in &ea {
+        for &b in &eb {
+            let dot = a.vector.dot(b.vector);
+            if dot.abs() <= T::EPSILON * a.length * b.length {
                 continue;
             }
-            let (v, m, n) = closed_edge_pair(p0, da, len_a, q0, db, len_b).unwrap_or_else(|| {
+            let (v, m, n) = closed_edge_pair(a, b).unwrap_or_else(|| {
                 exact = false;
-                edge_pair(&rule, p0, da, len_a, q0, db, len_b)
+                edge_pair(&rule, a, b)
             });
             total += dot * v;
             magnitude += dot.abs() * m;
@@ -86,15 +99,9 @@ fn needs_cut<T: Real>(delta: T, order: usize) -> bool {
 /// ∫₀¹∫₀¹ ln |P + σ d_a − Q − τ d_b| dτ dσ (see the module docs), the same integral of the
 /// magnitudes of the closed form's two terms (what its rounding scales with), and the
 /// evaluations.
-pub(super) fn edge_pair<T: Real>(
-    rule: &GaussRule<T>,
-    p: Vec3<T>,
-    da: Vec3<T>,
-    len_a: T,
-    q: Vec3<T>,
-    db: Vec3<T>,
-    len_b: T,
-) -> (T, T, u64) {
+pub(super) fn edge_pair<T: Real>(rule: &GaussRule<T>, a: Edge<T>, b: Edge<T>) -> (T, T, u64) {
+    let (p, da, len_a) = (a.start, a.vector, a.length);
+    let (q, db, len_b) = (b.start, b.vector, b.length);
     let e = db.scale(T::ONE / len_b);
     // Foot of x(σ) along e: u₀(σ) = f0 + σ f1.
     let (f0, f1) = ((p - q).dot(e), da.dot(e));
@@ -172,14 +179,9 @@ pub(super) fn edge_pair<T: Real>(
 /// other: the terms are differences of nearly equal values there, while the graded rule keeps
 /// the digits). The geometry is at unit size, where ∫∫ |ln r| is O(1): the rule's own rounding
 /// is about ε·max(|value|, 1), whatever the sign changes of ln r make of the value.
-pub(super) fn closed_edge_pair<T: Real>(
-    p: Vec3<T>,
-    da: Vec3<T>,
-    len_a: T,
-    q: Vec3<T>,
-    db: Vec3<T>,
-    len_b: T,
-) -> Option<(T, T, u64)> {
+pub(super) fn closed_edge_pair<T: Real>(a: Edge<T>, b: Edge<T>) -> Option<(T, T, u64)> {
+    let (p, da, len_a) = (a.start, a.vector, a.length);
+    let (q, db, len_b) = (b.start, b.vector, b.length);
     let tiny = T::from_f64(16.0) * T::EPSILON;
     let parallel = tiny * len_a * len_b;
     let (value, magnitude, terms) = if da.cross(db).norm2() <= parallel * parallel {

@@ -250,14 +250,14 @@ fn closed_edge_pairs_match_known_integrals_and_the_graded_rule() {
     use crate::vec3::vec3;
     let (o, x, y) = (vec3(0.0, 0.0, 0.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0));
     // ∫₀¹∫₀¹ ln |s − s′| = −3/2; ∫₀¹∫₀¹ ½ ln(s² + s′²) = (ln 2 − 3 + π/2)/2.
-    let same = closed_edge_pair(o, x, 1.0, o, x, 1.0).unwrap().0;
+    let same = closed_edge_pair(Edge::new(o, x), Edge::new(o, x)).unwrap().0;
     assert!((same + 1.5).abs() < 1e-15, "{same}");
-    let right = closed_edge_pair(o, x, 1.0, o, y, 1.0).unwrap().0;
+    let right = closed_edge_pair(Edge::new(o, x), Edge::new(o, y)).unwrap().0;
     let exact = (2f64.ln() - 3.0 + core::f64::consts::FRAC_PI_2) / 2.0;
     assert!((right - exact).abs() < 1e-15, "{right} vs {exact}");
     // Skew and crossing edges have no closed form here.
-    assert!(closed_edge_pair(o, x, 1.0, vec3(0.5, -0.5, 0.3), y, 1.0).is_none());
-    assert!(closed_edge_pair(o, x, 1.0, vec3(0.5, -0.5, 0.0), y, 1.0).is_none());
+    assert!(closed_edge_pair(Edge::new(o, x), Edge::new(vec3(0.5, -0.5, 0.3), y)).is_none());
+    assert!(closed_edge_pair(Edge::new(o, x), Edge::new(vec3(0.5, -0.5, 0.0), y)).is_none());
 
     let mut state = 0x2545_f491_4f6c_dd1du64;
     let mut next = || {
@@ -286,13 +286,13 @@ fn closed_edge_pairs_match_known_integrals_and_the_graded_rule() {
                 (start - db, db)
             }
         };
-        let Some((closed, magnitude, _)) = closed_edge_pair(p, da, da.norm(), q, db, db.norm()) else { continue };
+        let Some((closed, magnitude, _)) = closed_edge_pair(Edge::new(p, da), Edge::new(q, db)) else { continue };
         if case % 2 == 0 {
             parallel += 1;
         } else {
             pointed += 1;
         }
-        let (graded, _, _) = edge_pair(&rule, p, da, da.norm(), q, db, db.norm());
+        let (graded, _, _) = edge_pair(&rule, Edge::new(p, da), Edge::new(q, db));
         assert!(
             (closed - graded).abs() < 1e-14 * magnitude.max(1.0),
             "case {case}: {closed} vs {graded} (magnitude {magnitude})"
