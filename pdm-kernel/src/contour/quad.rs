@@ -107,8 +107,10 @@ pub(super) fn edge_pair<T: Real>(rule: &GaussRule<T>, a: Edge<T>, b: Edge<T>) ->
     let (f0, f1) = ((p - q).dot(e), da.dot(e));
     let mut cuts = [T::ZERO; 5];
     let mut nc = 0usize;
+    // A cut only where the uncut rule would not be exact to rounding ([`needs_cut`]).
+    let distance = |s: T| segment_distance(p + da.scale(s) - q, db, len_b) / len_a;
     let mut add = |x: T| {
-        if x > T::ZERO && x < T::ONE {
+        if x > T::ZERO && x < T::ONE && needs_cut(distance(x), rule.order()) {
             if let Some(slot) = cuts.get_mut(nc) {
                 *slot = x;
                 nc += 1;
@@ -125,20 +127,7 @@ pub(super) fn edge_pair<T: Real>(rule: &GaussRule<T>, a: Edge<T>, b: Edge<T>) ->
     if c11 > T::EPSILON * len_a * len_a {
         add(-c0.dot(c1) / c11);
     }
-    // A cut only where the uncut rule would not be exact to rounding ([`needs_cut`]).
-    let distance = |s: T| segment_distance(p + da.scale(s) - q, db, len_b) / len_a;
-    let mut kept = 0usize;
-    for k in 0..nc {
-        if let Some(&x) = cuts.get(k) {
-            if needs_cut(distance(x), rule.order()) {
-                if let Some(slot) = cuts.get_mut(kept) {
-                    *slot = x;
-                }
-                kept += 1;
-            }
-        }
-    }
-    let used = cuts.get_mut(..kept).unwrap_or_default();
+    let used = cuts.get_mut(..nc).unwrap_or_default();
     sort(used);
     let half_inv = T::HALF / len_b;
     // [G(L − u₀) − G(−u₀)]/2L with G's two arctangents as one: atan((L − u₀)/η) + atan(u₀/η)
@@ -185,7 +174,7 @@ pub(super) fn closed_edge_pair<T: Real>(a: Edge<T>, b: Edge<T>) -> Option<(T, T,
     let tiny = T::from_f64(16.0) * T::EPSILON;
     let parallel = tiny * len_a * len_b;
     let (value, magnitude, terms) = if da.cross(db).norm2() <= parallel * parallel {
-        parallel_edges(p, da, len_a, q, db, len_b)
+        parallel_edges(a, b)
     } else {
         // A common end, and each edge as a vector away from it.
         let touch = tiny * len_a.max(len_b);
@@ -212,11 +201,12 @@ const CLOSED_CANCELLATION: f64 = 256.0;
 ///
 /// divided by 2(u₁ − u₀)L_b; the polynomial part −3w²/2 sums to −3(u₁ − u₀)L_b exactly. Two identical collinear edges of length L give
 /// L²(ln L² − 3)/(2L²) (`../shared/REFERENCES.md`).
-fn parallel_edges<T: Real>(p: Vec3<T>, da: Vec3<T>, len_a: T, q: Vec3<T>, db: Vec3<T>, len_b: T) -> (T, T, u64) {
-    let e = db.scale(T::ONE / len_b);
-    let w = p - q;
+fn parallel_edges<T: Real>(a: Edge<T>, b: Edge<T>) -> (T, T, u64) {
+    let (len_a, len_b) = (a.length, b.length);
+    let e = b.vector.scale(T::ONE / len_b);
+    let w = a.start - b.start;
     let h = w.cross(e).norm();
-    let (f0, f1) = (w.dot(e), da.dot(e));
+    let (f0, f1) = (w.dot(e), a.vector.dot(e));
     let (u0, u1) = if f1 < T::ZERO { (f0 + f1, f0) } else { (f0, f0 + f1) };
     let terms = [big_k(u1, h), big_k(u0 - len_b, h), -big_k(u1 - len_b, h), -big_k(u0, h)];
     let scale = T::ONE / (T::TWO * len_a * len_b);

@@ -282,7 +282,8 @@ where
         .flatten();
     #[cfg(feature = "closed-form")]
     if let Some(Ok((v, c, r))) = flat {
-        if !crate::bounds::lost_digits(v, r) && !crate::bounds::cancels(v, r) {
+        // (`cancels` is the stricter test: a value that passes it has not lost its digits.)
+        if !crate::bounds::cancels(v, r) {
             return Ok(Some((v, c, r)));
         }
     }
