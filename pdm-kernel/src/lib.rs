@@ -113,6 +113,8 @@ pub use surface::{
     Quadrilateral, Side, Sphere, Surface,
 };
 pub use vec3::{vec3, Vec3};
+#[cfg(feature = "closed-form")]
+pub use visibility::Caster;
 pub use visibility::{AnyOccluder, Occluder};
 
 /// The pieces of the pair methods that the workspace's own tests, benches and fuzz targets

@@ -7,7 +7,7 @@
 //! These occluders have no closed-form visibility along lines (`line_polynomials` answers
 //! "not known"): the kernel's occluded paths bracket and bisect their edges instead.
 
-use pdm_kernel::{AnyOccluder, Ball, Occluder, Quadric, Real, Vec3};
+use pdm_kernel::{AnyOccluder, Ball, Caster, Occluder, Quadric, Real, Vec3};
 
 use super::shape::{Geom, Rect};
 
@@ -210,6 +210,13 @@ impl<T: Real> Occluder<T> for SceneOccluder<T> {
         match self {
             Self::Whole(o) => o.event_quadrics(corner, edge, out),
             Self::Part(_) => false,
+        }
+    }
+    /// A whole flat polygon or sphere says so; a part of a surface only "nothing may cut".
+    fn shadow_casters(&self, p: Vec3<T>, b: &[Vec3<T>], bounds: &Ball<T>, out: &mut dyn FnMut(Caster<'_, T>)) -> bool {
+        match self {
+            Self::Whole(o) => o.shadow_casters(p, b, bounds, out),
+            Self::Part(o) => !o.may_block_between(&Ball { center: p, radius: T::ZERO }, bounds),
         }
     }
     /// A whole sphere says so (the kernel then takes a point's view of a parallelogram past it

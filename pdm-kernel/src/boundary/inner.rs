@@ -16,6 +16,10 @@ pub(super) struct Inner<'x, T: Real, SB: Surface<T> + ?Sized, O: ?Sized> {
     pub(super) probes: usize,
     /// b's affine map when visibility is handled in closed form.
     pub(super) affine: Option<(Vec3<T>, Vec3<T>, Vec3<T>)>,
+    /// b's affine map where b is a parallelogram, whether or not its lines are in closed form
+    /// (too many occluders' polynomials for one line's buffer): b less flat occluders' shadows.
+    #[cfg(feature = "closed-form")]
+    pub(super) parallelogram: Option<(Vec3<T>, Vec3<T>, Vec3<T>)>,
     /// b's t-lines have trigonometric facing tests ([`Surface::facing_along_t`]) and no
     /// occluder can cut: visibility along them in closed form.
     #[cfg(feature = "closed-form")]
@@ -516,150 +520,8 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
         if n < 3 {
             return Some(T::ZERO);
         }
-        // Positive orientation about the directions from p (P's normal by the right-hand rule
-        // pointing away from p), which the cone's circle shares with increasing ψ below.
-        let first = poly.first().copied().unwrap_or(Vec3::ZERO);
-        let (second, third) = (poly.get(1).copied().unwrap_or(first), poly.get(2).copied().unwrap_or(first));
-        if (second - first).cross(third - first).dot(first - p) < T::ZERO {
-            poly.get_mut(..n).unwrap_or_default().reverse();
-        }
-        let used = poly.get(..n).unwrap_or_default();
-        let w = ball.center - p;
-        let dist2 = w.norm2();
-        let r2 = ball.radius * ball.radius;
-        if !(dist2 > r2) {
-            return None;
-        }
-        let k = dist2 - r2;
-        let inside = |d: Vec3<T>| {
-            let wd = w.dot(d);
-            wd > T::ZERO && wd * wd >= k * d.norm2()
-        };
-        // The cone's frame: ŵ, e₁, e₂ right-handed.
-        let dist = dist2.sqrt();
-        let axis = w.scale(T::ONE / dist);
-        let helper =
-            if axis.x.abs() < T::HALF { vec3(T::ONE, T::ZERO, T::ZERO) } else { vec3(T::ZERO, T::ONE, T::ZERO) };
-        let e1 = helper.cross(axis);
-        let e1 = e1.scale(T::ONE / e1.norm());
-        let e2 = axis.cross(e1);
-        let (sin_a, cos_a) = (ball.radius / dist, k.sqrt() / dist);
-        // A point of C's circle as its unit direction (cos ψ, sin ψ) about the axis.
-        let angle = |d: Vec3<T>| {
-            let (x, y) = (d.dot(e1), d.dot(e2));
-            let r = (x * x + y * y).sqrt();
-            if r > T::ZERO {
-                (x / r, y / r)
-            } else {
-                (T::ONE, T::ZERO)
-            }
-        };
-        // The circle's term from ψ₀ to ψ₁ (counter-clockwise, Δ = ψ₁ − ψ₀ in [0, 2π)), with
-        // Δsin ψ = 2 cos ψ̄ sin(Δ/2) and Δcos ψ = −2 sin ψ̄ sin(Δ/2) (ψ̄ the mid-angle) and Δ
-        // from the two directions: relative to the arc's length, where differences of angles
-        // and of their sines would carry an absolute ε (a thin sliver of b left visible
-        // beside the cone has short arcs and a J many orders below b's).
-        let circle = |(x0, y0): (T, T), (x1, y1): (T, T)| {
-            let mut delta = (x0 * y1 - y0 * x1).atan2(x0 * x1 + y0 * y1);
-            if delta < T::ZERO {
-                delta += T::TWO * T::PI;
-            }
-            let (sh, ch) = (delta * T::HALF).sin_cos();
-            let (mx, my) = (x0 * ch - y0 * sh, x0 * sh + y0 * ch);
-            sin_a * (sin_a * np.dot(axis) * delta - cos_a * T::TWO * sh * (np.dot(e1) * mx + np.dot(e2) * my))
-        };
-        // The visible region P \ C directly (no difference of two projected solid angles that
-        // cancel where the shadow covers most of b): P's edges outside C, and C's circle inside
-        // P traversed backwards.
-        // Whether each piece of P's boundary lies in C, piece by piece around P: C's boundary is
-        // crossed where that changes, also at a vertex of P that lies on it (rounding there
-        // can put the edge's root just outside the edge).
-        let mut walk = Crossings {
-            visible: T::ZERO,
-            magnitude: T::ZERO,
-            entries: 0,
-            exits: 0,
-            first_entry: None,
-            pending_exit: None,
-        };
-        let mut outside = false;
-        let (mut previous, mut first): (Option<bool>, Option<bool>) = (None, None);
-        for (j, &a) in used.iter().enumerate() {
-            let Some(&b) = used.get((j + 1) % n) else { continue };
-            let (da, e) = (a - p, b - a);
-            // g(λ) = (w·d)² − k|d|² along d = da + λ·e: C's boundary where it vanishes.
-            let (wa, we) = (w.dot(da), w.dot(e));
-            let qa = we * we - k * e.norm2();
-            let qb = T::TWO * (wa * we - k * da.dot(e));
-            let qc = wa * wa - k * da.norm2();
-            let mut cuts = [T::ZERO, T::ONE, T::ONE, T::ONE];
-            let mut nc = 1usize;
-            crate::visibility::polynomial_roots(qa, qb, qc, &mut |x| {
-                if x > T::ZERO && x < T::ONE {
-                    if let Some(slot) = cuts.get_mut(nc) {
-                        *slot = x;
-                        nc += 1;
-                    }
-                }
-            });
-            let cuts = cuts.get_mut(..=nc).unwrap_or_default();
-            super::breaks::sort(cuts);
-            for piece in cuts.windows(2) {
-                let &[lo, hi] = piece else { continue };
-                if !(hi > lo) {
-                    continue;
-                }
-                let (u, v) = (da + e.scale(lo), da + e.scale(hi));
-                let now = inside(da + e.scale((lo + hi) * T::HALF));
-                if previous == Some(!now) {
-                    walk.cross(now, angle(u), &circle);
-                }
-                previous = Some(now);
-                first.get_or_insert(now);
-                if !now {
-                    outside = true;
-                    let (term, size) = arc(np, u, v);
-                    walk.visible += term;
-                    walk.magnitude += size;
-                }
-            }
-        }
-        // Around the last vertex back to the first.
-        if let (Some(last), Some(now), Some(&a)) = (previous, first, used.first()) {
-            if last != now {
-                walk.cross(now, angle(a - p), &circle);
-            }
-        }
-        let Crossings { mut visible, mut magnitude, entries, exits, first_entry, pending_exit } = walk;
-        if entries != exits {
-            return None;
-        }
-        if !outside && entries == 0 {
-            // P lies wholly inside C: b is hidden from p.
-            return Some(T::ZERO);
-        }
-        match (pending_exit, first_entry) {
-            (Some(exit), Some(entry)) => {
-                let term = circle(exit, entry);
-                visible -= term;
-                magnitude += term.abs();
-            }
-            (None, None) if entries == 0 => {
-                // No edge runs inside C: C lies wholly inside P (its axis inside every edge's
-                // half-space), or apart from it.
-                let within = used
-                    .iter()
-                    .enumerate()
-                    .all(|(j, &a)| used.get((j + 1) % n).is_some_and(|&b| axis.dot((a - p).cross(b - p)) > T::ZERO));
-                if within {
-                    let cap = T::TWO * T::PI * sin_a * sin_a * np.dot(axis);
-                    visible -= cap;
-                    magnitude += cap.abs();
-                }
-            }
-            (None, None) => {}
-            _ => return None,
-        }
+        let used = poly.get_mut(..n).unwrap_or_default();
+        let (visible, magnitude) = polygon_past_sphere(p, np, used, ball)?;
         // The terms' rounding against J, or, where the cone leaves only slivers of P, against
         // P's own (unshadowed) J: a sliver's J is a difference of nearly equal angles however
         // it is computed (the lines round the ends of its pieces alike), so no method holds it
@@ -832,6 +694,159 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
     }
 }
 
+/// P \ C for a convex polygon P (vertices `poly`, reordered to positive orientation about the
+/// directions from p) and the cone C of directions from p to the sphere `ball` (p outside
+/// it): twice the projected solid angle of the region, and the sum of its terms' magnitudes
+/// ([`Inner::point_past_sphere`], whose docs give the method); `(0, 0)` where P lies wholly
+/// inside C, `None` where the walk around P does not close.
+#[cfg(feature = "closed-form")]
+pub(super) fn polygon_past_sphere<T: Real>(
+    p: Vec3<T>,
+    np: Vec3<T>,
+    poly: &mut [Vec3<T>],
+    ball: &Ball<T>,
+) -> Option<(T, T)> {
+    // Positive orientation about the directions from p (P's normal by the right-hand rule
+    // pointing away from p), which the cone's circle shares with increasing ψ below.
+    let n = poly.len();
+    let first = poly.first().copied().unwrap_or(Vec3::ZERO);
+    let (second, third) = (poly.get(1).copied().unwrap_or(first), poly.get(2).copied().unwrap_or(first));
+    if (second - first).cross(third - first).dot(first - p) < T::ZERO {
+        poly.reverse();
+    }
+    let used: &[Vec3<T>] = poly;
+    let w = ball.center - p;
+    let dist2 = w.norm2();
+    let r2 = ball.radius * ball.radius;
+    if !(dist2 > r2) {
+        return None;
+    }
+    let k = dist2 - r2;
+    let inside = |d: Vec3<T>| {
+        let wd = w.dot(d);
+        wd > T::ZERO && wd * wd >= k * d.norm2()
+    };
+    // The cone's frame: ŵ, e₁, e₂ right-handed.
+    let dist = dist2.sqrt();
+    let axis = w.scale(T::ONE / dist);
+    let helper = if axis.x.abs() < T::HALF { vec3(T::ONE, T::ZERO, T::ZERO) } else { vec3(T::ZERO, T::ONE, T::ZERO) };
+    let e1 = helper.cross(axis);
+    let e1 = e1.scale(T::ONE / e1.norm());
+    let e2 = axis.cross(e1);
+    let (sin_a, cos_a) = (ball.radius / dist, k.sqrt() / dist);
+    // A point of C's circle as its unit direction (cos ψ, sin ψ) about the axis.
+    let angle = |d: Vec3<T>| {
+        let (x, y) = (d.dot(e1), d.dot(e2));
+        let r = (x * x + y * y).sqrt();
+        if r > T::ZERO {
+            (x / r, y / r)
+        } else {
+            (T::ONE, T::ZERO)
+        }
+    };
+    // The circle's term from ψ₀ to ψ₁ (counter-clockwise, Δ = ψ₁ − ψ₀ in [0, 2π)), with
+    // Δsin ψ = 2 cos ψ̄ sin(Δ/2) and Δcos ψ = −2 sin ψ̄ sin(Δ/2) (ψ̄ the mid-angle) and Δ
+    // from the two directions: relative to the arc's length, where differences of angles
+    // and of their sines would carry an absolute ε (a thin sliver of b left visible
+    // beside the cone has short arcs and a J many orders below b's).
+    let circle = |(x0, y0): (T, T), (x1, y1): (T, T)| {
+        let mut delta = (x0 * y1 - y0 * x1).atan2(x0 * x1 + y0 * y1);
+        if delta < T::ZERO {
+            delta += T::TWO * T::PI;
+        }
+        let (sh, ch) = (delta * T::HALF).sin_cos();
+        let (mx, my) = (x0 * ch - y0 * sh, x0 * sh + y0 * ch);
+        sin_a * (sin_a * np.dot(axis) * delta - cos_a * T::TWO * sh * (np.dot(e1) * mx + np.dot(e2) * my))
+    };
+    // The visible region P \ C directly (no difference of two projected solid angles that
+    // cancel where the shadow covers most of b): P's edges outside C, and C's circle inside
+    // P traversed backwards.
+    // Whether each piece of P's boundary lies in C, piece by piece around P: C's boundary is
+    // crossed where that changes, also at a vertex of P that lies on it (rounding there
+    // can put the edge's root just outside the edge).
+    let mut walk =
+        Crossings { visible: T::ZERO, magnitude: T::ZERO, entries: 0, exits: 0, first_entry: None, pending_exit: None };
+    let mut outside = false;
+    let (mut previous, mut first): (Option<bool>, Option<bool>) = (None, None);
+    for (j, &a) in used.iter().enumerate() {
+        let Some(&b) = used.get((j + 1) % n) else { continue };
+        let (da, e) = (a - p, b - a);
+        // g(λ) = (w·d)² − k|d|² along d = da + λ·e: C's boundary where it vanishes.
+        let (wa, we) = (w.dot(da), w.dot(e));
+        let qa = we * we - k * e.norm2();
+        let qb = T::TWO * (wa * we - k * da.dot(e));
+        let qc = wa * wa - k * da.norm2();
+        let mut cuts = [T::ZERO, T::ONE, T::ONE, T::ONE];
+        let mut nc = 1usize;
+        crate::visibility::polynomial_roots(qa, qb, qc, &mut |x| {
+            if x > T::ZERO && x < T::ONE {
+                if let Some(slot) = cuts.get_mut(nc) {
+                    *slot = x;
+                    nc += 1;
+                }
+            }
+        });
+        let cuts = cuts.get_mut(..=nc).unwrap_or_default();
+        super::breaks::sort(cuts);
+        for piece in cuts.windows(2) {
+            let &[lo, hi] = piece else { continue };
+            if !(hi > lo) {
+                continue;
+            }
+            let (u, v) = (da + e.scale(lo), da + e.scale(hi));
+            let now = inside(da + e.scale((lo + hi) * T::HALF));
+            if previous == Some(!now) {
+                walk.cross(now, angle(u), &circle);
+            }
+            previous = Some(now);
+            first.get_or_insert(now);
+            if !now {
+                outside = true;
+                let (term, size) = arc(np, u, v);
+                walk.visible += term;
+                walk.magnitude += size;
+            }
+        }
+    }
+    // Around the last vertex back to the first.
+    if let (Some(last), Some(now), Some(&a)) = (previous, first, used.first()) {
+        if last != now {
+            walk.cross(now, angle(a - p), &circle);
+        }
+    }
+    let Crossings { mut visible, mut magnitude, entries, exits, first_entry, pending_exit } = walk;
+    if entries != exits {
+        return None;
+    }
+    if !outside && entries == 0 {
+        // P lies wholly inside C: b is hidden from p.
+        return Some((T::ZERO, T::ZERO));
+    }
+    match (pending_exit, first_entry) {
+        (Some(exit), Some(entry)) => {
+            let term = circle(exit, entry);
+            visible -= term;
+            magnitude += term.abs();
+        }
+        (None, None) if entries == 0 => {
+            // No edge runs inside C: C lies wholly inside P (its axis inside every edge's
+            // half-space), or apart from it.
+            let within = used
+                .iter()
+                .enumerate()
+                .all(|(j, &a)| used.get((j + 1) % n).is_some_and(|&b| axis.dot((a - p).cross(b - p)) > T::ZERO));
+            if within {
+                let cap = T::TWO * T::PI * sin_a * sin_a * np.dot(axis);
+                visible -= cap;
+                magnitude += cap.abs();
+            }
+        }
+        (None, None) => {}
+        _ => return None,
+    }
+    Some((visible, magnitude))
+}
+
 /// Lambert's terms over a polygon seen from p: the sum of γ_k n̂_p·(R_k × R_{k+1})/|R_k × R_{k+1}|
 /// over its edges (twice the projected solid angle, signed by the polygon's orientation) and the
 /// sum of their magnitudes.
@@ -848,7 +863,7 @@ fn arcs<T: Real>(p: Vec3<T>, np: Vec3<T>, poly: &[Vec3<T>]) -> (T, T) {
 
 /// One great-circle arc's term from direction a to direction b: γ n̂_p·(a × b)/|a × b| (γ the
 /// angle between them), and its magnitude; zero for parallel directions.
-fn arc<T: Real>(np: Vec3<T>, a: Vec3<T>, b: Vec3<T>) -> (T, T) {
+pub(super) fn arc<T: Real>(np: Vec3<T>, a: Vec3<T>, b: Vec3<T>) -> (T, T) {
     let c = a.cross(b);
     let sine = c.norm();
     if !(sine > T::ZERO) {

@@ -67,6 +67,15 @@ impl<T: Real> Occluder<T> for AnyOccluder<T> {
         }
     }
     #[cfg(feature = "closed-form")]
+    fn shadow_casters(&self, p: Vec3<T>, b: &[Vec3<T>], bounds: &Ball<T>, out: &mut dyn FnMut(Caster<'_, T>)) -> bool {
+        match self {
+            Self::Parallelogram(o) => o.shadow_casters(p, b, bounds, out),
+            Self::Quadrilateral(o) => o.shadow_casters(p, b, bounds, out),
+            Self::Sphere(o) => o.shadow_casters(p, b, bounds, out),
+            _ => !self.may_block_between(&Ball { center: p, radius: T::ZERO }, bounds),
+        }
+    }
+    #[cfg(feature = "closed-form")]
     fn shadow_sphere(&self, a: &Ball<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
         match self {
             Self::Sphere(o) => o.shadow_sphere(a, b),
@@ -127,6 +136,10 @@ impl<T: Real, O: Occluder<T> + ?Sized> Occluder<T> for &O {
         (**self).hides_ball_from(p, b)
     }
     #[cfg(feature = "closed-form")]
+    fn shadow_casters(&self, p: Vec3<T>, b: &[Vec3<T>], bounds: &Ball<T>, out: &mut dyn FnMut(Caster<'_, T>)) -> bool {
+        (**self).shadow_casters(p, b, bounds, out)
+    }
+    #[cfg(feature = "closed-form")]
     fn shadow_sphere(&self, a: &Ball<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
         (**self).shadow_sphere(a, b)
     }
@@ -150,6 +163,10 @@ impl<T: Real, O: Occluder<T>> Occluder<T> for [O] {
     #[cfg(feature = "closed-form")]
     fn hides_ball_from(&self, p: Vec3<T>, b: &Ball<T>) -> bool {
         self.iter().any(|o| o.hides_ball_from(p, b))
+    }
+    #[cfg(feature = "closed-form")]
+    fn shadow_casters(&self, p: Vec3<T>, b: &[Vec3<T>], bounds: &Ball<T>, out: &mut dyn FnMut(Caster<'_, T>)) -> bool {
+        self.iter().all(|o| o.shadow_casters(p, b, bounds, out))
     }
     #[cfg(feature = "closed-form")]
     fn shadow_sphere(&self, a: &Ball<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
@@ -177,6 +194,10 @@ impl<T: Real, O: Occluder<T>, const N: usize> Occluder<T> for [O; N] {
         self.as_slice().hides_ball_from(p, b)
     }
     #[cfg(feature = "closed-form")]
+    fn shadow_casters(&self, p: Vec3<T>, b: &[Vec3<T>], bounds: &Ball<T>, out: &mut dyn FnMut(Caster<'_, T>)) -> bool {
+        self.as_slice().shadow_casters(p, b, bounds, out)
+    }
+    #[cfg(feature = "closed-form")]
     fn shadow_sphere(&self, a: &Ball<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
         self.as_slice().shadow_sphere(a, b)
     }
@@ -200,6 +221,10 @@ impl<T: Real, O: Occluder<T>, const N: usize> Occluder<T> for heapless::Vec<O, N
     #[cfg(feature = "closed-form")]
     fn hides_ball_from(&self, p: Vec3<T>, b: &Ball<T>) -> bool {
         self.as_slice().hides_ball_from(p, b)
+    }
+    #[cfg(feature = "closed-form")]
+    fn shadow_casters(&self, p: Vec3<T>, b: &[Vec3<T>], bounds: &Ball<T>, out: &mut dyn FnMut(Caster<'_, T>)) -> bool {
+        self.as_slice().shadow_casters(p, b, bounds, out)
     }
     #[cfg(feature = "closed-form")]
     fn shadow_sphere(&self, a: &Ball<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
@@ -227,6 +252,10 @@ impl<T: Real, O: Occluder<T>> Occluder<T> for Option<O> {
         self.as_ref().is_some_and(|o| o.hides_ball_from(p, b))
     }
     #[cfg(feature = "closed-form")]
+    fn shadow_casters(&self, p: Vec3<T>, b: &[Vec3<T>], bounds: &Ball<T>, out: &mut dyn FnMut(Caster<'_, T>)) -> bool {
+        self.as_ref().is_none_or(|o| o.shadow_casters(p, b, bounds, out))
+    }
+    #[cfg(feature = "closed-form")]
     fn shadow_sphere(&self, a: &Ball<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
         self.as_ref().map_or(Some(None), |o| o.shadow_sphere(a, b))
     }
@@ -250,6 +279,10 @@ impl<T: Real, A: Occluder<T>, B: Occluder<T>> Occluder<T> for (A, B) {
     #[cfg(feature = "closed-form")]
     fn hides_ball_from(&self, p: Vec3<T>, b: &Ball<T>) -> bool {
         self.0.hides_ball_from(p, b) || self.1.hides_ball_from(p, b)
+    }
+    #[cfg(feature = "closed-form")]
+    fn shadow_casters(&self, p: Vec3<T>, b: &[Vec3<T>], bounds: &Ball<T>, out: &mut dyn FnMut(Caster<'_, T>)) -> bool {
+        self.0.shadow_casters(p, b, bounds, out) && self.1.shadow_casters(p, b, bounds, out)
     }
     #[cfg(feature = "closed-form")]
     fn shadow_sphere(&self, a: &Ball<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
@@ -277,6 +310,12 @@ impl<T: Real, A: Occluder<T>, B: Occluder<T>, C: Occluder<T>> Occluder<T> for (A
     #[cfg(feature = "closed-form")]
     fn hides_ball_from(&self, p: Vec3<T>, b: &Ball<T>) -> bool {
         self.0.hides_ball_from(p, b) || self.1.hides_ball_from(p, b) || self.2.hides_ball_from(p, b)
+    }
+    #[cfg(feature = "closed-form")]
+    fn shadow_casters(&self, p: Vec3<T>, b: &[Vec3<T>], bounds: &Ball<T>, out: &mut dyn FnMut(Caster<'_, T>)) -> bool {
+        self.0.shadow_casters(p, b, bounds, out)
+            && self.1.shadow_casters(p, b, bounds, out)
+            && self.2.shadow_casters(p, b, bounds, out)
     }
     #[cfg(feature = "closed-form")]
     fn shadow_sphere(&self, a: &Ball<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {

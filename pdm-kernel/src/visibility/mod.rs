@@ -50,6 +50,18 @@ pub use combine::AnyOccluder;
 pub(crate) use roots::polynomial_roots;
 use roots::*;
 
+/// An occluder as [`Occluder::shadow_casters`] passes it: a flat convex polygon (its corners in
+/// order around the outline; a repeated corner is allowed, a triangle as a quadrilateral) or a
+/// sphere.
+#[cfg(feature = "closed-form")]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Caster<'x, T> {
+    /// A flat convex polygon.
+    Polygon(&'x [Vec3<T>]),
+    /// A sphere (centre and radius).
+    Sphere(Ball<T>),
+}
+
 /// Something that may block the line of sight between two points.
 ///
 /// Sphere, parallelogram, quadrilateral (and triangle), disk, cylinder, cone and Bézier patch are occluders; several combine as a tuple, an
@@ -119,6 +131,19 @@ pub trait Occluder<T: Real> {
     #[cfg(feature = "closed-form")]
     fn shadow_sphere(&self, a: &Ball<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
         (!self.may_block_between(a, b)).then_some(None)
+    }
+
+    /// The occluders that may cut a segment from the point `p` to the flat convex polygon `b`
+    /// (inside `bounds`), where each is a flat convex polygon or a sphere: passes each to `out`
+    /// ([`Caster`]) and returns `true`; or returns `false` where some part that may cut is
+    /// neither. `boundary/` then takes the inner integral over a parallelogram b from p in
+    /// closed form: b less the polygons' shadows, less one sphere's cone of directions. The
+    /// default passes nothing and says whether nothing may cut
+    /// ([`may_block_between`](Occluder::may_block_between) from p to `bounds`).
+    #[cfg(feature = "closed-form")]
+    fn shadow_casters(&self, p: Vec3<T>, b: &[Vec3<T>], bounds: &Ball<T>, out: &mut dyn FnMut(Caster<'_, T>)) -> bool {
+        let _ = (b, out);
+        !self.may_block_between(&Ball { center: p, radius: T::ZERO }, bounds)
     }
 
     /// Conservative culling the other way: `true` only if every segment from `p` to a point of

@@ -31,6 +31,14 @@ impl<T: Real> Occluder<T> for Parallelogram<T> {
         let radius = (self.edge_t + self.edge_s).norm().max((self.edge_t - self.edge_s).norm()) * T::HALF;
         ball_may_cut_pair(center, radius, a, b)
     }
+    #[cfg(feature = "closed-form")]
+    fn shadow_casters(&self, p: Vec3<T>, _b: &[Vec3<T>], bounds: &Ball<T>, out: &mut dyn FnMut(Caster<'_, T>)) -> bool {
+        if self.may_block_between(&Ball { center: p, radius: T::ZERO }, bounds) {
+            let (o, et, es) = (self.origin, self.edge_t, self.edge_s);
+            out(Caster::Polygon(&[o, o + et, o + et + es, o + es]));
+        }
+        true
+    }
     /// The crossing τ = offset / (n·w) and its coordinates (u, v) are ratios of polynomials
     /// linear in τ: the switches are n·w = 0, q on the plane, and u, v ∈ {0, 1} (numerators
     /// multiplied by n·w).

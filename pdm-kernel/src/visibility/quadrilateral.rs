@@ -41,6 +41,13 @@ impl<T: Real> Occluder<T> for Quadrilateral<T> {
         let radius = self.corners.iter().fold(T::ZERO, |r, &p| r.max((p - center).norm()));
         ball_may_cut_pair(center, radius, a, b)
     }
+    #[cfg(feature = "closed-form")]
+    fn shadow_casters(&self, p: Vec3<T>, _b: &[Vec3<T>], bounds: &Ball<T>, out: &mut dyn FnMut(Caster<'_, T>)) -> bool {
+        if self.may_block_between(&Ball { center: p, radius: T::ZERO }, bounds) {
+            out(Caster::Polygon(&self.corners));
+        }
+        true
+    }
     /// The crossing τ = offset / (n·w) and the side functions at the hit point are ratios of
     /// polynomials linear in τ: the switches are n·w = 0, q on the plane, and each side
     /// function zero (numerators multiplied by n·w).

@@ -18,6 +18,44 @@ impl<T: Real> Occluder<T> for Sphere<T> {
         let cuts = self.may_block_between(a, b);
         Some(cuts.then_some(Ball { center: self.center, radius: self.radius }))
     }
+    /// The sphere itself where it may cut a segment from p to the convex polygon b: nothing
+    /// where it lies outside the cone from p to b's ball, or beyond one face plane of their
+    /// hull (the pyramid with apex p over b: b's plane and the planes through p and each side
+    /// of b) by its radius. A room's lamp, which the ball of a whole wall takes in, passes the
+    /// second test from most points of the room.
+    #[cfg(feature = "closed-form")]
+    fn shadow_casters(&self, p: Vec3<T>, b: &[Vec3<T>], bounds: &Ball<T>, out: &mut dyn FnMut(Caster<'_, T>)) -> bool {
+        let ball = Ball { center: self.center, radius: self.radius };
+        if !self.may_block_between(&Ball { center: p, radius: T::ZERO }, bounds) {
+            return true;
+        }
+        let n = b.len();
+        if n < 3 {
+            out(Caster::Sphere(ball));
+            return true;
+        }
+        let centroid = b.iter().fold(Vec3::ZERO, |c, &v| c + v).scale(T::ONE / T::from_usize(n));
+        // Beyond the plane through x with normal m (either way round: the side away from
+        // `inside`) by more than the radius.
+        let beyond = |x: Vec3<T>, m: Vec3<T>, inside: Vec3<T>| {
+            let length = m.norm();
+            if !(length > T::ZERO) {
+                return false;
+            }
+            let m = if m.dot(inside - x) > T::ZERO { -m } else { m };
+            m.dot(self.center - x) > self.radius * length * (T::ONE + T::GEOMETRY_TOLERANCE.sqrt())
+        };
+        let (Some(&b0), Some(&b1), Some(&b2)) = (b.first(), b.get(1), b.get(2)) else { return true };
+        let apart = beyond(b0, (b1 - b0).cross(b2 - b0), p)
+            || (0..n).any(|k| {
+                let (v, w) = (b.get(k).copied().unwrap_or(b0), b.get((k + 1) % n).copied().unwrap_or(b0));
+                beyond(p, (v - p).cross(w - p), centroid)
+            });
+        if !apart {
+            out(Caster::Sphere(ball));
+        }
+        true
+    }
     /// Every segment from p into ball b crosses the sphere when b's cone from p (half-angle β,
     /// sin β = r_b/|c_b − p|) lies inside the sphere's tangent cone (half-angle α,
     /// sin α = R/|c − p|) with margin, θ + β < α for the angle θ between the axes (compared

@@ -869,3 +869,97 @@ fn sphere_cells_in_a_sliver_with_their_own_sphere_as_occluder() {
         }
     }
 }
+
+/// Pairs across flat occluders and a sphere, whose inner integral is b less the polygons'
+/// shadows and the sphere's cone, in closed form (`boundary/shadows.rs`). References by
+/// symmetry, no kernel code: between two parallel unit squares 1 apart, a screen in the middle
+/// plane covering x > 0.5 blocks a segment exactly where its crossing has x > 0.5, i.e. where
+/// x_a + x_b > 1; the mirror x → 1 − x of both squares swaps those segments with the others,
+/// so the screen passes exactly half of C-11. A sphere centred on the mirror plane keeps that:
+/// with it, the pair is exactly half the pair across the sphere alone (which pdm takes by the
+/// cone subtraction, another path). Both the parallelogram and the quadrilateral screen, both
+/// argument orders, fixed orders and the tolerance mode, whose estimate must cover the error.
+mod polygon_shadows {
+    use super::*;
+    use pdm_kernel::{adaptive_exchange, Adaptive, AnyOccluder, Parallelogram, Quadrilateral};
+
+    fn squares() -> (Parallelogram<f64>, Parallelogram<f64>) {
+        let bottom = Parallelogram::new(vec3(0.0, 0.0, 0.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0)).unwrap();
+        let top = Parallelogram::new(vec3(0.0, 0.0, 1.0), vec3(0.0, 1.0, 0.0), vec3(1.0, 0.0, 0.0)).unwrap();
+        (bottom, top)
+    }
+
+    fn screens() -> [AnyOccluder<f64>; 2] {
+        let flat = Parallelogram::new(vec3(0.5, -50.0, 0.5), vec3(50.0, 0.0, 0.0), vec3(0.0, 100.0, 0.0)).unwrap();
+        let quad = Quadrilateral::new([
+            vec3(0.5, -50.0, 0.5),
+            vec3(50.5, -50.0, 0.5),
+            vec3(50.5, 50.0, 0.5),
+            vec3(0.5, 50.0, 0.5),
+        ])
+        .unwrap();
+        [AnyOccluder::Parallelogram(flat), AnyOccluder::Quadrilateral(quad)]
+    }
+
+    #[test]
+    fn a_screen_over_half_the_view_passes_half_of_it() {
+        let (bottom, top) = squares();
+        let (a, b) = (Patch::whole(&bottom).unwrap(), Patch::whole(&top).unwrap());
+        let half = 0.5 * exact::parallel_rectangles(1.0, 1.0, 1.0);
+        for screen in screens() {
+            for order in [4, 8] {
+                let settings = PairSettings { order, singular_order: order, boundaries: true };
+                for (name, e) in [
+                    ("a → b", pair_exchange::<f64, _, _, _, 256>(&a, &b, settings, &screen).unwrap()),
+                    ("b → a", pair_exchange::<f64, _, _, _, 256>(&b, &a, settings, &screen).unwrap()),
+                ] {
+                    println!("order {order} {name}: {:.1e} off", rel(e.value, half));
+                    assert!(
+                        rel(e.value, half) < 1e-12 || order < 8,
+                        "order {order} {name}: {:e} against {half:e}",
+                        e.value
+                    );
+                }
+            }
+            for tol in [1e-4, 1e-10] {
+                let e = adaptive_exchange::<f64, _, _, _, 256>(&a, &b, Adaptive::new(tol), &screen).unwrap();
+                let (error, estimate) = ((e.value - half).abs(), e.error.unwrap());
+                println!("tol {tol:e}: {:.1e} off, estimate {:.1e}", error / half, estimate / half);
+                assert!(
+                    e.converged && error <= estimate && error <= tol * half,
+                    "tol {tol:e}: {error:e}, {estimate:e}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn a_screen_and_a_sphere_on_the_mirror_plane_pass_half_of_the_sphere_alone() {
+        let (bottom, top) = squares();
+        let (a, b) = (Patch::whole(&bottom).unwrap(), Patch::whole(&top).unwrap());
+        let sphere = Sphere::outer(vec3(0.5, 0.45, 0.3), 0.15).unwrap();
+        let alone = adaptive_exchange::<f64, _, _, _, 256>(&a, &b, Adaptive::new(1e-10), &sphere).unwrap();
+        let (reference, uncertainty) = (0.5 * alone.value, 0.5 * alone.error.unwrap());
+        println!(
+            "sphere alone: {:e}, estimate {:.1e}, converged {}",
+            alone.value,
+            alone.error.unwrap(),
+            alone.converged
+        );
+        for screen in screens() {
+            let both = (screen, AnyOccluder::Sphere(sphere));
+            for tol in [1e-4, 1e-7] {
+                let e = adaptive_exchange::<f64, _, _, _, 256>(&a, &b, Adaptive::new(tol), &both).unwrap();
+                let (error, estimate) = ((e.value - reference).abs(), e.error.unwrap());
+                println!(
+                    "tol {tol:e}: {:.1e} off, estimate {:.1e}, {} evaluations",
+                    error / reference,
+                    estimate / reference,
+                    e.evaluations
+                );
+                assert!(error <= estimate + uncertainty, "tol {tol:e}: {error:e} off, estimate {estimate:e}");
+                assert!(!e.converged || error <= tol * reference + uncertainty, "tol {tol:e}: {error:e} off");
+            }
+        }
+    }
+}
