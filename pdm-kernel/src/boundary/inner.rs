@@ -554,14 +554,28 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
         (ball.center - p).norm() - ball.radius < ball.radius
     }
 
-    /// The distance from `ball` to the part r of b ([`distance_to_part`]).
+    /// The distance from `ball` to the part r of b: exact on a parallelogram (the nearest
+    /// point of its plane, or of its sides where that falls outside), else by refinement
+    /// ([`distance_to_part`], which along a contact refines b down to the ball's size: cells
+    /// of an outer patch graded towards a touching b took 10⁵ parts each).
     pub(super) fn distance_from(&self, ball: &Ball<T>, r: ParamRect<T>) -> Result<T, PdmError> {
+        if let Some(map) = self.map() {
+            return Ok((distance_to_parallelogram(ball.center, map, r) - ball.radius).max(T::ZERO));
+        }
         distance_to_part(self.surface, self.affine, ball, r, T::MAX, 0)
+    }
+
+    /// b's affine map where b is a parallelogram (whether or not its lines are in closed form).
+    fn map(&self) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {
+        #[cfg(feature = "closed-form")]
+        return self.parallelogram.or(self.affine);
+        #[cfg(not(feature = "closed-form"))]
+        self.affine
     }
 
     /// The smallest ball known to contain the part r of b (exact corners when flat).
     pub(super) fn ball_of(&self, r: ParamRect<T>) -> Result<Ball<T>, PdmError> {
-        part_ball(self.surface, self.affine, r)
+        part_ball(self.surface, self.map(), r)
     }
 
     /// J(p) = ∫_b visible (n̂_p·e)(−n_q·e)/L⁴ dq (without the 1/π) over the part r of b,
@@ -845,6 +859,32 @@ pub(super) fn polygon_past_sphere<T: Real>(
         _ => return None,
     }
     Some((visible, magnitude))
+}
+
+/// The distance from x to the part r of the parallelogram o + t·et + s·es: to the foot of the
+/// perpendicular where it falls inside, else to the nearest of the four sides.
+fn distance_to_parallelogram<T: Real>(x: Vec3<T>, (o, et, es): (Vec3<T>, Vec3<T>, Vec3<T>), r: ParamRect<T>) -> T {
+    let d = x - o;
+    let (tt, ts, ss) = (et.dot(et), et.dot(es), es.dot(es));
+    let (bt, bs) = (et.dot(d), es.dot(d));
+    let det = tt * ss - ts * ts;
+    if det > T::ZERO {
+        let (t, s) = ((bt * ss - bs * ts) / det, (bs * tt - bt * ts) / det);
+        if t >= r.t0 && t <= r.t1 && s >= r.s0 && s <= r.s1 {
+            return (x - (o + et.scale(t) + es.scale(s))).norm();
+        }
+    }
+    let at = |t: T, s: T| o + et.scale(t) + es.scale(s);
+    let corners = [at(r.t0, r.s0), at(r.t1, r.s0), at(r.t1, r.s1), at(r.t0, r.s1)];
+    let mut best = T::MAX;
+    for (k, &a) in corners.iter().enumerate() {
+        let b = corners.get((k + 1) % 4).copied().unwrap_or(a);
+        let e = b - a;
+        let length2 = e.norm2();
+        let f = if length2 > T::ZERO { ((x - a).dot(e) / length2).max(T::ZERO).min(T::ONE) } else { T::ZERO };
+        best = best.min((x - (a + e.scale(f))).norm());
+    }
+    best
 }
 
 /// Lambert's terms over a polygon seen from p: the sum of γ_k n̂_p·(R_k × R_{k+1})/|R_k × R_{k+1}|

@@ -962,4 +962,42 @@ mod polygon_shadows {
             }
         }
     }
+
+    /// A touching pair across a flat occluder, which takes the boundary path whole
+    /// (`pair::route`, `contact_across_shadows`): perpendicular unit squares sharing an edge
+    /// (C-14), and a screen in their bisecting plane x = z over y > 0.5, its edge on the shared
+    /// edge. Every segment between the squares crosses the bisecting plane once, and is blocked
+    /// exactly where it crosses at y > 0.5; the mirror y → 1 − y maps the pair onto itself and
+    /// those segments onto the others, so the screen passes exactly half of C-14.
+    #[test]
+    fn a_screen_on_the_shared_edge_passes_half_of_c14() {
+        let floor = Parallelogram::new(vec3(0.0, 0.0, 0.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0)).unwrap();
+        let wall = Parallelogram::new(vec3(0.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0), vec3(0.0, 0.0, 1.0)).unwrap();
+        let (a, b) = (Patch::whole(&floor).unwrap(), Patch::whole(&wall).unwrap());
+        let screen = Parallelogram::new(vec3(0.0, 0.5, 0.0), vec3(10.0, 0.0, 10.0), vec3(0.0, 10.0, 0.0)).unwrap();
+        let half = 0.5 * exact::perpendicular_rectangles(1.0, 1.0, 1.0);
+        for order in [6, 10] {
+            let settings = PairSettings { order, singular_order: order, boundaries: true };
+            for (name, e) in [
+                ("floor → wall", pair_exchange::<f64, _, _, _, 256>(&a, &b, settings, &screen).unwrap()),
+                ("wall → floor", pair_exchange::<f64, _, _, _, 256>(&b, &a, settings, &screen).unwrap()),
+            ] {
+                println!("order {order} {name}: {:.1e} off, {} evaluations", rel(e.value, half), e.evaluations);
+                assert!(rel(e.value, half) < 1e-4, "order {order} {name}: {:e} against {half:e}", e.value);
+            }
+        }
+        for tol in [1e-3, 1e-6] {
+            let e = adaptive_exchange::<f64, _, _, _, 256>(&a, &b, Adaptive::new(tol), &screen).unwrap();
+            let (error, estimate) = ((e.value - half).abs(), e.error.unwrap());
+            println!(
+                "tol {tol:e}: {:.1e} off, estimate {:.1e}, converged {}, {} evaluations",
+                error / half,
+                estimate / half,
+                e.converged,
+                e.evaluations
+            );
+            assert!(error <= estimate, "tol {tol:e}: {error:e} off, estimate {estimate:e}");
+            assert!(!e.converged || error <= tol * half, "tol {tol:e}: {error:e} off");
+        }
+    }
 }
