@@ -27,7 +27,7 @@ use super::*;
 use crate::visibility::Caster;
 
 /// Most occluder polygons casting a shadow on b from one point.
-const MAX_SHADOWS: usize = 8;
+const MAX_SHADOWS: usize = 16;
 
 /// Most sides of one shadow: a quadrilateral clipped by two planes.
 const SHADOW_SIDES: usize = 6;
@@ -36,7 +36,7 @@ const SHADOW_SIDES: usize = 6;
 const PIECE_VERTICES: usize = 10;
 
 /// Most pieces waiting to be cut by the later shadows.
-const MAX_PIECES: usize = 16;
+const MAX_PIECES: usize = 24;
 
 /// A line a·t + b·s + c in b's parameters, positive inside a shadow.
 type Side<T> = [T; 3];

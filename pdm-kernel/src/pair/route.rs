@@ -58,13 +58,11 @@ where
     let collapsed = crate::singular::contact_reaches_collapsed_side(a, b, adjacency);
     match adjacency {
         Adjacency::SharedEdge { .. } | Adjacency::SharedVertex { .. } => {
-            if splits.allowed
-                && (splits.collapsed || !collapsed)
-                && occluders.may_block_between(&a.enclosing_ball(), &b.enclosing_ball())
-            {
-                if contact_across_shadows(a, b, occluders) {
-                    return Route::Separate;
-                }
+            let may_cut = occluders.may_block_between(&a.enclosing_ball(), &b.enclosing_ball());
+            // At any depth: the transforms' occlusion test per node is what this avoids.
+            if may_cut && contact_across_shadows(a, b, occluders) {
+                Route::Separate
+            } else if splits.allowed && (splits.collapsed || !collapsed) && may_cut {
                 Route::SplitContact
             } else {
                 Route::Touching { adjacency, gap, collapsed }
