@@ -771,6 +771,25 @@ mod tests {
         })
     }
 
+    /// Uniform numbers in [−1, 1) from an xorshift generator seeded with `state`.
+    fn xorshift(mut state: u64) -> impl FnMut() -> f64 {
+        move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        }
+    }
+
+    /// A random parallelogram in the plane z = 0 (normal +z) centred on the origin, sides
+    /// 0.5 … 1.5 long, tilted off the axes.
+    fn random_plate(next: &mut impl FnMut() -> f64) -> Parallelogram<f64> {
+        let et = vec3(1.0 + 0.5 * next(), 0.3 * next(), 0.0);
+        let es = vec3(0.3 * next(), 1.0 + 0.5 * next(), 0.0);
+        let o = vec3(-0.5 * et.x - 0.5 * es.x, -0.5 * et.y - 0.5 * es.y, 0.0);
+        Parallelogram::new(o, et, es).unwrap()
+    }
+
     /// J(p) over `plate` past flat occluders: (b less their shadows if it answers, the lines at
     /// order 20 with the occluders' polynomials, the solid angle `plate` subtends facing p
     /// squarely), or `None`.
@@ -802,20 +821,11 @@ mod tests {
     fn polygon_shadows_match_the_lines() {
         use crate::surface::Quadrilateral;
         use crate::visibility::AnyOccluder;
-        let mut state = 0x2545_f491_4f6c_dd1d_u64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
+        let mut next = xorshift(0x2545_f491_4f6c_dd1d);
         let (mut answered, mut shadowed, mut worst) = (0usize, 0usize, 0.0f64);
         let cases = 300;
         for case in 0..cases {
-            let et = vec3(1.0 + 0.5 * next(), 0.3 * next(), 0.0);
-            let es = vec3(0.3 * next(), 1.0 + 0.5 * next(), 0.0);
-            let o = vec3(-0.5 * et.x - 0.5 * es.x, -0.5 * et.y - 0.5 * es.y, 0.0);
-            let plate = Parallelogram::new(o, et, es).unwrap();
+            let plate = random_plate(&mut next);
             let p = vec3(0.8 * next(), 0.8 * next(), 1.0 + 0.8 * next().abs());
             let np = vec3(0.6 * next(), 0.6 * next(), -0.5 + 0.5 * next());
             let np = np.scale(1.0 / np.norm());
@@ -972,21 +982,12 @@ mod tests {
     /// unshadowed J; most cases must answer.
     #[test]
     fn cone_subtraction_matches_the_lines() {
-        let mut state = 0x5851_f42d_4c95_7f2d_u64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
+        let mut next = xorshift(0x5851_f42d_4c95_7f2d);
         let (mut answered, mut shadowed, mut worst) = (0usize, 0usize, 0.0f64);
         let cases = 400;
         for _ in 0..cases {
             // b in the plane z = 0 (normal +z), p above it, the sphere between.
-            let et = vec3(1.0 + 0.5 * next(), 0.3 * next(), 0.0);
-            let es = vec3(0.3 * next(), 1.0 + 0.5 * next(), 0.0);
-            let o = vec3(-0.5 * et.x - 0.5 * es.x, -0.5 * et.y - 0.5 * es.y, 0.0);
-            let plate = Parallelogram::new(o, et, es).unwrap();
+            let plate = random_plate(&mut next);
             let p = vec3(0.8 * next(), 0.8 * next(), 1.0 + 0.8 * next().abs());
             let np = vec3(0.6 * next(), 0.6 * next(), 0.5 + 0.5 * next());
             let np = np.scale(1.0 / np.norm());

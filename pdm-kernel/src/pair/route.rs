@@ -90,10 +90,8 @@ where
 {
     #[cfg(feature = "closed-form")]
     {
-        let (Some(_), Some((o, et, es))) = (a.surface().affine_map(), b.surface().affine_map()) else { return false };
-        let r = b.rect();
-        let at = |t: T, s: T| o + et.scale(t) + es.scale(s);
-        let corners = [at(r.t0, r.s0), at(r.t1, r.s0), at(r.t1, r.s1), at(r.t0, r.s1)];
+        let (Some(_), Some(_)) = (a.surface().affine_map(), b.surface().affine_map()) else { return false };
+        let Some(corners) = b.surface().straight_corners(b.rect()) else { return false };
         occluders.shadow_casters(a.enclosing_ball().center, &corners, &b.enclosing_ball(), &mut |_| {})
     }
     #[cfg(not(feature = "closed-form"))]
