@@ -75,7 +75,7 @@ where
 
 /// Whether a touching pair that an occluder may cut takes the boundary path whole instead of
 /// [`Route::SplitContact`]: both patches parallelograms and the occluders flat convex polygons
-/// and spheres ([`Occluder::shadow_casters`], asked from a's centre). The inner integral from
+/// and spheres, at least one polygon ([`Occluder::shadow_casters`], asked from a's centre). The inner integral from
 /// every outer point is then exact however close the point comes to the contact
 /// (`boundary/shadows.rs`), and the outer rule is graded towards b (`boundary::outer_cells`);
 /// splitting cells along the contact instead ran the regularising transforms with the
@@ -92,7 +92,13 @@ where
     {
         let (Some(_), Some(_)) = (a.surface().affine_map(), b.surface().affine_map()) else { return false };
         let Some(corners) = b.surface().straight_corners(b.rect()) else { return false };
-        occluders.shadow_casters(a.enclosing_ball().center, &corners, &b.enclosing_ball(), &mut |_| {})
+        // With spheres alone the contact is split as before: its separate sub-pairs get the
+        // sphere's outer events (exponential), which the whole pair's outer rule would not.
+        let mut polygons = false;
+        let casters = occluders.shadow_casters(a.enclosing_ball().center, &corners, &b.enclosing_ball(), &mut |c| {
+            polygons |= matches!(c, crate::visibility::Caster::Polygon(_));
+        });
+        casters && polygons
     }
     #[cfg(not(feature = "closed-form"))]
     {
