@@ -231,11 +231,7 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
         }
         let j = sum.abs() * T::HALF;
         let limit = polygon_cancellation::<T>();
-        // The solid angle b would subtend from p facing it squarely (as `Inner::reach`).
-        let (dt, ds) = (r.t1 - r.t0, r.s1 - r.s0);
-        let centre = o + et.scale(r.t0 + dt * T::HALF) + es.scale(r.s0 + ds * T::HALF);
-        let reach = (et.cross(es).norm() * dt.abs() * ds.abs() / (centre - p).norm2()).min(T::TWO * T::PI);
-        let settled = magnitude <= limit * sum.abs() || magnitude <= limit * T::TWO * reach;
+        let settled = magnitude <= limit * sum.abs() || magnitude <= limit * T::TWO * self.reach(p);
         (j.is_finite() && settled).then_some(j)
     }
 }
