@@ -343,7 +343,10 @@ edge_s = [2, 0, 0]
     assert!((with_tube - with_cone).abs() <= 1e-9 * with_tube, "{with_tube} vs {with_cone}");
     let (with_square, with_net) = (f(square), f(&net));
     assert!(with_square < open * 0.95, "{with_square} vs {open}");
-    assert!((with_square - with_net).abs() <= 1e-6 * with_square, "{with_square} vs {with_net}");
+    // The rectangle's outer events are placed into the rule (its value at order 8 is the same
+    // to 13 digits at orders 12 and 16); the net's outer rule samples across the shadow's
+    // kinks, 8e-6 off at order 8 and within 3e-6 of the rectangle at tolerance 1e-8.
+    assert!((with_square - with_net).abs() <= 2e-5 * with_square, "{with_square} vs {with_net}");
 }
 
 /// An enclosure with a modelling gap is reported on every row it affects: the cube with its
@@ -594,6 +597,25 @@ fn room_example_loads_with_quadrilateral_facets() {
     // 4 floor pieces around the cabinet, 5 room faces, 6 table faces, 5 cabinet faces, the lamp.
     assert_eq!(s.patches.len(), 4 + 5 + 6 + 5 + 1);
     assert!(s.enclosure);
+}
+
+/// The box-in-a-room example (an OBJ file, every surface an occluder, as a user would run it):
+/// each row of the enclosure sums to 1 within 1e-9 and within its estimates, every pair meets
+/// the tolerance. The room's faces meet along edges with the box between them (the contour form
+/// less the blocked part); before, the ceiling's row missed 1 by 6e-6, with 15 pairs above the
+/// default tolerance.
+#[test]
+fn box_room_example_rows_sum_to_one() {
+    let path = format!("{}/../examples/scenes/box_room.toml", env!("CARGO_MANIFEST_DIR"));
+    let s = pdm_host::scene::load(std::path::Path::new(&path)).unwrap_or_else(|e| panic!("{e}"));
+    let r = run(&s, PairMethod::Tolerance(1e-10));
+    let errors = r.surfaces.errors.clone().expect("the tolerance mode gives estimates");
+    for (i, sum) in r.surfaces.row_sums.iter().enumerate() {
+        let estimate: f64 = errors[i].iter().sum();
+        println!("{}: row sum misses 1 by {:.1e}, estimates {estimate:.1e}", r.surfaces.names[i], sum - 1.0);
+        assert!((sum - 1.0).abs() < 1e-9 && (sum - 1.0).abs() <= estimate + 1e-14, "{}: {sum}", r.surfaces.names[i]);
+    }
+    assert!(r.diagnostics.enclosure_gaps.is_empty(), "{:?}", r.diagnostics.enclosure_gaps);
 }
 
 /// A unit cube as a View3D file (format F 3, vertices counter-clockwise seen from inside),

@@ -213,10 +213,16 @@ impl<T: Real> Occluder<T> for SceneOccluder<T> {
         }
     }
     /// A whole flat polygon or sphere says so; a part of a surface only "nothing may cut".
-    fn shadow_casters(&self, p: Vec3<T>, b: &[Vec3<T>], bounds: &Ball<T>, out: &mut dyn FnMut(Caster<'_, T>)) -> bool {
+    fn shadow_casters(
+        &self,
+        from: &Ball<T>,
+        b: &[Vec3<T>],
+        bounds: &Ball<T>,
+        out: &mut dyn FnMut(Caster<'_, T>),
+    ) -> bool {
         match self {
-            Self::Whole(o) => o.shadow_casters(p, b, bounds, out),
-            Self::Part(o) => !o.may_block_between(&Ball { center: p, radius: T::ZERO }, bounds),
+            Self::Whole(o) => o.shadow_casters(from, b, bounds, out),
+            Self::Part(o) => !o.may_block_between(from, bounds),
         }
     }
     /// A whole sphere says so (the kernel then takes a point's view of a parallelogram past it

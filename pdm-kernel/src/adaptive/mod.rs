@@ -312,5 +312,62 @@ where
         }
         Route::Identical { collapsed: false, .. } => identical::<T, SA, O, CAP>(a, settings, occluders, depth),
         Route::Separate => separate::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth),
+        Route::ContactPastShadows => {
+            #[cfg(feature = "closed-form")]
+            if let Some(tally) = contact_past_shadows::<T, SA, SB, O, CAP>(a, b, settings, occluders)? {
+                return Ok(tally);
+            }
+            separate::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth)
+        }
     }
+}
+
+/// A touching flat pair across flat occluders ([`Route::ContactPastShadows`]): the unoccluded
+/// exchange U in the tolerance mode at half the tolerance, less the blocked part B
+/// ([`crate::boundary::blocked_unchecked`]) at orders 4, 6, … until its estimate (as
+/// [`by_order_doubling`]'s, three orders at least) is within the other half of the tolerance
+/// on U − B; the estimate is the sum of both. `None` where B does not apply or does not meet
+/// its half by `max_order` (the caller then takes the pair by its other route, which splits).
+#[cfg(feature = "closed-form")]
+#[inline(never)]
+fn contact_past_shadows<T, SA, SB, O, const CAP: usize>(
+    a: &Patch<'_, T, SA>,
+    b: &Patch<'_, T, SB>,
+    settings: Adaptive<T>,
+    occluders: &O,
+) -> Result<Option<Tally<T>>, PdmError>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
+    let half = settings.tolerance * T::HALF;
+    let blocked = |order: usize| crate::boundary::blocked_unchecked(a, b, order, occluders);
+    let first = 4usize.min(settings.max_order);
+    let Some((mut previous, mut evaluations)) = blocked(first)? else { return Ok(None) };
+    let unoccluded = recurse::<T, SA, SB, (), CAP>(a, b, Adaptive { tolerance: half, ..settings }, &(), 0)?;
+    evaluations = evaluations.saturating_add(unoccluded.evaluations);
+    let mut previous_difference: Option<T> = None;
+    let mut order = first + 2;
+    while order <= settings.max_order {
+        let Some((next, n)) = blocked(order)? else { return Ok(None) };
+        evaluations = evaluations.saturating_add(n);
+        let difference = (next - previous).abs();
+        let estimate = previous_difference.map_or(difference, |d1| difference.max((d1 * difference).sqrt()))
+            + T::from_f64(ROUNDING) * T::EPSILON * next.abs();
+        let value = unoccluded.value - next;
+        if previous_difference.is_some() && (estimate <= half * value.abs() || estimate <= T::MIN_POSITIVE) {
+            return Ok(Some(Tally {
+                value,
+                error: unoccluded.error + estimate,
+                converged: unoccluded.converged,
+                evaluations,
+            }));
+        }
+        previous = next;
+        previous_difference = Some(difference);
+        order += 2;
+    }
+    Ok(None)
 }

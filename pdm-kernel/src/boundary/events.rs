@@ -55,11 +55,15 @@ type Conic<T> = [T; 6];
 /// A line in the outer patch's parameters, L(t, s) = a·t + b·s + c, as `[a, b, c]`.
 type Line2<T> = [T; 3];
 
-/// One event curve: Q = 0 where the guard (L₀·L₁ ≥ 0, if any) holds.
+/// One event curve: Q = 0 where the guard (L₀·L₁ ≥ 0, if any) holds; `grade`: the outer rule's
+/// pieces are graded towards its breaks (square-root and 3/2-power points, a sphere's
+/// tangencies, and the contact of touching patches), or not (a kink between analytic sides,
+/// which needs only the break).
 #[derive(Clone, Copy)]
 struct Curve<T> {
     conic: Conic<T>,
     guard: Option<[Line2<T>; 2]>,
+    grade: bool,
 }
 
 impl<T: Real> Curve<T> {
@@ -76,13 +80,65 @@ impl<T: Real> Curve<T> {
     }
 }
 
-/// The event curves of one (outer, inner) pair.
-pub(super) struct Events<T> {
-    curves: [Curve<T>; MAX_EVENT_CURVES],
-    n: usize,
+impl<T: Real> Curve<T> {
+    /// For a line (no quadratic terms): whether the part of it where the guard holds meets the
+    /// rectangle `r`. The line is clipped to `r` (Liang–Barsky); the guard's two lines are
+    /// linear along it, so their product is non-negative somewhere on the segment iff it is at
+    /// an end or both change sign on it.
+    fn line_meets(&self, r: ParamRect<T>) -> bool {
+        let [_, _, _, a, b, c] = self.conic;
+        let n2 = a * a + b * b;
+        if !(n2 > T::ZERO) {
+            return false;
+        }
+        // p(λ) = p₀ + λ·d on the line, d = (−b, a).
+        let (t0, s0) = (-c * a / n2, -c * b / n2);
+        let (dt, ds) = (-b, a);
+        let (mut lo, mut hi) = (-T::MAX, T::MAX);
+        for (p, d, min, max) in [(t0, dt, r.t0, r.t1), (s0, ds, r.s0, r.s1)] {
+            if d == T::ZERO {
+                if p < min || p > max {
+                    return false;
+                }
+            } else {
+                let (x, y) = ((min - p) / d, (max - p) / d);
+                lo = lo.max(x.min(y));
+                hi = hi.min(x.max(y));
+            }
+        }
+        if lo > hi {
+            return false;
+        }
+        let Some([g0, g1]) = self.guard else { return true };
+        let value = |[ga, gb, gc]: Line2<T>, l: T| ga * (t0 + l * dt) + gb * (s0 + l * ds) + gc;
+        let (u0, u1, w0, w1) = (value(g0, lo), value(g0, hi), value(g1, lo), value(g1, hi));
+        u0 * w0 >= T::ZERO || u1 * w1 >= T::ZERO || (u0 * u1 <= T::ZERO && w0 * w1 <= T::ZERO)
+    }
 }
 
-impl<T: Real> Events<T> {
+/// The event curves of one (outer, inner) pair: at most `N` curves, at most `SB` breaks in s
+/// and `TB` along one outer line (ends included).
+pub(super) struct Events<T, const N: usize, const SB: usize, const TB: usize> {
+    curves: [Curve<T>; N],
+    n: usize,
+    /// Whether the curves pushed are graded ([`Curve`]).
+    grade: bool,
+    /// The outer patch's parameter rectangle, where the rule may reach past a cell towards a
+    /// break just outside it ([`graded_sum`]); `None`: anywhere on the patch's surface. Past
+    /// the patch J need not continue J inside it (an occluder standing on the patch's edge
+    /// hides everything from beyond it).
+    limit: Option<ParamRect<T>>,
+}
+
+/// The events of an occluder that gives its quadrics (a sphere), or of a curved inner patch.
+pub(super) type QuadricEvents<T> = Events<T, MAX_EVENT_CURVES, MAX_S_BREAKS, MAX_T_BREAKS>;
+
+impl<T: Real, const N: usize, const SB: usize, const TB: usize> Events<T, N, SB, TB> {
+    /// No curves yet.
+    pub(super) fn empty(grade: bool, limit: Option<ParamRect<T>>) -> Self {
+        Self { curves: [Curve { conic: [T::ZERO; 6], guard: None, grade }; N], n: 0, grade, limit }
+    }
+
     /// The events of outer a (affine map `outer`: p = o + t·e_t + s·e_s) against inner b (affine
     /// map `inner` over the parameter rectangle `rect`) across `occluders`; `None` if an
     /// occluder cannot give its quadrics, more than one occluder gives them
@@ -96,7 +152,7 @@ impl<T: Real> Events<T> {
     ) -> Option<Self> {
         let (o, et, es) = outer;
         let (bo, bt, bs) = inner;
-        let mut events = Self { curves: [Curve { conic: [T::ZERO; 6], guard: None }; MAX_EVENT_CURVES], n: 0 };
+        let mut events = Self::empty(true, None);
         let mut overflow = false;
         let corner = |t: T, s: T| bo + bt.scale(t) + bs.scale(s);
         let corners =
@@ -149,7 +205,7 @@ impl<T: Real> Events<T> {
         if !(height.abs() > bounds.radius * (T::ONE + T::GEOMETRY_TOLERANCE)) {
             return None;
         }
-        let mut events = Self { curves: [Curve { conic: [T::ZERO; 6], guard: None }; MAX_EVENT_CURVES], n: 0 };
+        let mut events = Self::empty(true, None);
         let mut overflow = false;
         let supported = surface.event_quadrics(rect, &mut |q| overflow |= !events.push_quadric(outer, q));
         (supported && !overflow && events.n > 0).then_some(events)
@@ -158,7 +214,7 @@ impl<T: Real> Events<T> {
     /// Keeps the quadric `q` restricted to a (affine map `outer`): with p = o + t·e_t + s·e_s and
     /// v₀ = o − origin, F = (v₀ + t·e_t + s·e_s)ᵀ M (…) + g·(…) + c, a conic in (t, s), and each
     /// guard g·v a line.
-    fn push_quadric(&mut self, outer: (Vec3<T>, Vec3<T>, Vec3<T>), q: Quadric<T>) -> bool {
+    pub(super) fn push_quadric(&mut self, outer: (Vec3<T>, Vec3<T>, Vec3<T>), q: Quadric<T>) -> bool {
         let (o, et, es) = outer;
         let v0 = o - q.origin;
         let conic = [
@@ -184,7 +240,7 @@ impl<T: Real> Events<T> {
         }
         match self.curves.get_mut(self.n) {
             Some(slot) => {
-                *slot = Curve { conic: scaled(conic), guard };
+                *slot = Curve { conic: scaled(conic), guard, grade: self.grade };
                 self.n += 1;
                 true
             }
@@ -196,6 +252,19 @@ impl<T: Real> Events<T> {
         self.curves.get(..self.n).unwrap_or_default()
     }
 
+    /// Leaves out the curves from `from` on if the last one is a line whose guarded part misses
+    /// the rectangle `r` ([`Curve::line_meets`]).
+    pub(super) fn keep_if_meets(&mut self, from: usize, r: ParamRect<T>) {
+        if self.n > from && self.curves.get(self.n - 1).is_some_and(|curve| !curve.line_meets(r)) {
+            self.n = from;
+        }
+    }
+
+    /// How many curves are kept.
+    pub(super) fn len(&self) -> usize {
+        self.n
+    }
+
     /// ∫∫ f(t, s) dt ds over `r` with the events placed into the rule (module docs); `f` is the
     /// outer integrand at a's parameters (J times a's area element).
     pub(super) fn integrate(
@@ -204,11 +273,12 @@ impl<T: Real> Events<T> {
         rule: &GaussRule<T>,
         f: &mut dyn FnMut(T, T) -> Result<T, PdmError>,
     ) -> Result<T, PdmError> {
-        let mut breaks = [T::ZERO; MAX_S_BREAKS];
+        let mut breaks = [(T::ZERO, false); SB];
         let mut n = 0usize;
-        let mut add = |x: T| place_near(x, r.s0, r.s1, &mut breaks, &mut n);
-        add(r.s0);
+        let mut place = |x: T, grade: bool| place_near(x, grade, r.s0, r.s1, &mut breaks, &mut n);
+        place(r.s0, false);
         for curve in self.used() {
+            let mut add = |x: T| place(x, curve.grade);
             let [tt, ts, ss, t1, s1, c] = curve.conic;
             // A t-edge crossed: Q(t_edge, s) = 0.
             for te in [r.t0, r.t1] {
@@ -264,8 +334,11 @@ impl<T: Real> Events<T> {
                 }
             }
         }
-        add(r.s1);
-        graded_sum(breaks.get_mut(..n).unwrap_or_default(), r.s0, r.s1, rule, &mut |s| self.line(r, s, rule, f))
+        place(r.s1, false);
+        let (lo, hi) = self.limit.map_or((-T::MAX, T::MAX), |l| (l.s0, l.s1));
+        graded_sum(breaks.get_mut(..n).unwrap_or_default(), r.s0, r.s1, (lo, hi), rule, &mut |s| {
+            self.line(r, s, rule, f)
+        })
     }
 
     /// ∫ f(t, s) dt over [r.t0, r.t1] at one s, with breaks at the conics' roots.
@@ -276,20 +349,21 @@ impl<T: Real> Events<T> {
         rule: &GaussRule<T>,
         f: &mut dyn FnMut(T, T) -> Result<T, PdmError>,
     ) -> Result<T, PdmError> {
-        let mut breaks = [T::ZERO; MAX_T_BREAKS];
+        let mut breaks = [(T::ZERO, false); TB];
         let mut n = 0usize;
-        let mut add = |x: T| place_near(x, r.t0, r.t1, &mut breaks, &mut n);
-        add(r.t0);
+        let mut place = |x: T, grade: bool| place_near(x, grade, r.t0, r.t1, &mut breaks, &mut n);
+        place(r.t0, false);
         for curve in self.used() {
             let [tt, ts, ss, t1, s1, c] = curve.conic;
             roots_near_double(tt, ts * s + t1, (ss * s + s1) * s + c, &mut |t| {
                 if curve.holds(t, s) {
-                    add(t);
+                    place(t, curve.grade);
                 }
             });
         }
-        add(r.t1);
-        graded_sum(breaks.get_mut(..n).unwrap_or_default(), r.t0, r.t1, rule, &mut |t| f(t, s))
+        place(r.t1, false);
+        let (lo, hi) = self.limit.map_or((-T::MAX, T::MAX), |l| (l.t0, l.t1));
+        graded_sum(breaks.get_mut(..n).unwrap_or_default(), r.t0, r.t1, (lo, hi), rule, &mut |t| f(t, s))
     }
 }
 
@@ -314,11 +388,17 @@ fn place<T: Real>(x: T, lo: T, hi: T, breaks: &mut [T], n: &mut usize) {
     }
 }
 
-/// [`place`] over [lo, hi] widened by its width on both sides: a break just outside the
-/// interval limits the rule on it as much as one inside ([`graded_sum`]).
-fn place_near<T: Real>(x: T, lo: T, hi: T, breaks: &mut [T], n: &mut usize) {
+/// Keeps a break x, and whether the rule is graded towards it, in [lo, hi] widened by its width
+/// on both sides (a break just outside the interval limits the rule on it as much as one
+/// inside, [`graded_sum`]) while `breaks` has room.
+fn place_near<T: Real>(x: T, grade: bool, lo: T, hi: T, breaks: &mut [(T, bool)], n: &mut usize) {
     let width = hi - lo;
-    place(x, lo - width, hi + width, breaks, n);
+    if x.is_finite() && x >= lo - width && x <= hi + width {
+        if let Some(slot) = breaks.get_mut(*n) {
+            *slot = (x, grade);
+            *n += 1;
+        }
+    }
 }
 
 /// The real roots of a·x² + b·x + c, and the double root −b/(2a) also where rounding has made
@@ -344,53 +424,78 @@ fn roots_near_double<T: Real>(a: T, b: T, c: T, out: &mut dyn FnMut(T)) {
 const NEAR_OUTSIDE: f64 = 8.0;
 
 /// ∫ g over [lo, hi] by the rule on the pieces between the `breaks` (which hold lo and hi, and
-/// may hold breaks outside [lo, hi]), each graded ([`graded`]) at every end that is a break
-/// inside (lo, hi) or an end that a break lies on too (held twice).
+/// may hold breaks outside [lo, hi]; the rule reaches past lo or hi only within
+/// [lowest, highest]), each graded ([`graded`]) at every end where a graded
+/// curve's break lies ([`Curve`]).
 ///
 /// A break just outside, at distance δ from an end, is a singularity at distance δ from the
 /// end piece: its rule converges at a rate that falls with δ / width (a tangency 1e-4 of the
 /// width past the end: 1e-7 at order 16), and on a grid of cells every event that crosses
 /// one cell passes just outside its neighbours, or on its edge, rounded to either side. Where
 /// δ is at most the end piece's width / [`NEAR_OUTSIDE`], the end piece [x, hi] is taken as
-/// [x, hi + δ] minus [hi, hi + δ], each graded towards the break: one piece more, and both
+/// [x, hi + δ] minus [hi, hi + δ], each graded towards the break if its curve is: one piece
+/// more, and both
 /// converge with the order. Unlike the inner rule's pieces
 /// (`for_each_piece`), a piece next to a much narrower one is not cut geometrically towards
 /// it: the outer curves of one pair often nearly meet (every corner and edge of b gives one,
 /// and they pass close to each other), and those cuts multiplied the outer points several-fold
 /// (up to 60× on a whole face) for little accuracy (BENCHMARKS.md, "Outer events").
 fn graded_sum<T: Real>(
-    breaks: &mut [T],
+    breaks: &mut [(T, bool)],
     lo: T,
     hi: T,
+    (lowest, highest): (T, T),
     rule: &GaussRule<T>,
     g: &mut dyn FnMut(T) -> Result<T, PdmError>,
 ) -> Result<T, PdmError> {
-    sort(breaks);
-    let at_lo = breaks.iter().filter(|&&x| x == lo).count() > 1;
-    let at_hi = breaks.iter().filter(|&&x| x == hi).count() > 1;
-    let grade = |x: T| (x != lo && x != hi) || (x == lo && at_lo) || (x == hi && at_hi);
-    let inside = |x: &&T| **x >= lo && **x <= hi;
+    sort_by_position(breaks);
+    // One entry per position, graded if any break there is.
+    let mut m = 0usize;
+    for k in 0..breaks.len() {
+        let Some(&(x, grade)) = breaks.get(k) else { break };
+        match m.checked_sub(1).and_then(|last| breaks.get_mut(last)) {
+            Some(last) if last.0 == x => last.1 |= grade,
+            _ => {
+                if let Some(slot) = breaks.get_mut(m) {
+                    *slot = (x, grade);
+                }
+                m += 1;
+            }
+        }
+    }
+    let breaks = breaks.get(..m).unwrap_or_default();
+    let at_lo = breaks.iter().any(|&(x, grade)| x == lo && grade);
+    let at_hi = breaks.iter().any(|&(x, grade)| x == hi && grade);
+    let inside = |x: &&(T, bool)| x.0 >= lo && x.0 <= hi;
     let near = T::from_f64(NEAR_OUTSIDE);
-    let first_end = breaks.iter().filter(inside).find(|&&x| x > lo).copied().unwrap_or(hi);
-    let last_start = breaks.iter().filter(inside).rev().find(|&&x| x < hi).copied().unwrap_or(lo);
-    let below =
-        breaks.iter().rev().find(|&&x| x < lo).copied().filter(|&x| !at_lo && (lo - x) * near <= first_end - lo);
-    let above = breaks.iter().find(|&&x| x > hi).copied().filter(|&x| !at_hi && (x - hi) * near <= hi - last_start);
+    let first_end = breaks.iter().filter(inside).find(|x| x.0 > lo).map_or(hi, |x| x.0);
+    let last_start = breaks.iter().filter(inside).rev().find(|x| x.0 < hi).map_or(lo, |x| x.0);
+    let below = breaks
+        .iter()
+        .rev()
+        .find(|x| x.0 < lo)
+        .copied()
+        .filter(|x| !at_lo && (lo - x.0) * near <= first_end - lo && x.0 >= lowest);
+    let above = breaks
+        .iter()
+        .find(|x| x.0 > hi)
+        .copied()
+        .filter(|x| !at_hi && (x.0 - hi) * near <= hi - last_start && x.0 <= highest);
     let mut total = T::ZERO;
     for w in breaks.windows(2) {
         let &[a, b] = w else { continue };
-        if !(b > a) || a < lo || b > hi {
+        if !(b.0 > a.0) || a.0 < lo || b.0 > hi {
             continue;
         }
-        let a = if a == lo { below.unwrap_or(a) } else { a };
-        let b = if b == hi { above.unwrap_or(b) } else { b };
-        total += piece(a, b, grade(a), grade(b), rule, g)?;
+        let a = if a.0 == lo { below.unwrap_or(a) } else { a };
+        let b = if b.0 == hi { above.unwrap_or(b) } else { b };
+        total += piece(a.0, b.0, a.1, b.1, rule, g)?;
     }
-    if let Some(x) = below {
-        total -= piece(x, lo, true, false, rule, g)?;
+    if let Some((x, grade)) = below {
+        total -= piece(x, lo, grade, false, rule, g)?;
     }
-    if let Some(x) = above {
-        total -= piece(hi, x, false, true, rule, g)?;
+    if let Some((x, grade)) = above {
+        total -= piece(hi, x, false, grade, rule, g)?;
     }
     Ok(total)
 }

@@ -866,7 +866,11 @@ pub(super) fn polygon_past_sphere<T: Real>(
 
 /// The distance from x to the part r of the parallelogram o + t·et + s·es: to the foot of the
 /// perpendicular where it falls inside, else to the nearest of the four sides.
-fn distance_to_parallelogram<T: Real>(x: Vec3<T>, (o, et, es): (Vec3<T>, Vec3<T>, Vec3<T>), r: ParamRect<T>) -> T {
+pub(super) fn distance_to_parallelogram<T: Real>(
+    x: Vec3<T>,
+    (o, et, es): (Vec3<T>, Vec3<T>, Vec3<T>),
+    r: ParamRect<T>,
+) -> T {
     let d = x - o;
     let (tt, ts, ss) = (et.dot(et), et.dot(es), es.dot(es));
     let (bt, bs) = (et.dot(d), es.dot(d));

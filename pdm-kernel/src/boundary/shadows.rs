@@ -107,7 +107,9 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
     /// a flat convex polygon or a sphere ([`Occluder::shadow_casters`]): the check before
     /// [`Self::point_past_polygons`], whose buffers are not put on the stack otherwise.
     pub(super) fn polygons_only(&self, p: Vec3<T>, bounds: &Ball<T>) -> bool {
-        self.corners().is_some_and(|corners| self.occluders.shadow_casters(p, &corners, bounds, &mut |_| {}))
+        self.corners().is_some_and(|corners| {
+            self.occluders.shadow_casters(&Ball { center: p, radius: T::ZERO }, &corners, bounds, &mut |_| {})
+        })
     }
 
     /// J(p) over a parallelogram b whose possible occluders from p are flat convex polygons and
@@ -138,38 +140,43 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
         let mut overflow = false;
         let corners = self.corners()?;
         let mut sphere: Option<Ball<T>> = None;
-        let supported = self.occluders.shadow_casters(p, &corners, bounds, &mut |caster| {
-            if overflow {
-                return;
-            }
-            let corners = match caster {
-                Caster::Polygon(corners) => corners,
-                // One sphere, wholly on p's side of b's plane (with a relative margin): every
-                // ray from p that meets it does so before b's plane, so its shadow is the cone
-                // of directions to it, taken from every piece (`polygon_past_sphere`).
-                Caster::Sphere(ball) => {
-                    let margin = ball.radius * T::GEOMETRY_TOLERANCE.sqrt();
-                    overflow |= sphere.is_some() || !(nq.dot(ball.center - o) > ball.radius + margin);
-                    sphere = Some(ball);
+        let supported =
+            self.occluders.shadow_casters(&Ball { center: p, radius: T::ZERO }, &corners, bounds, &mut |caster| {
+                if overflow {
                     return;
                 }
-            };
-            match shadow_of(corners, p, hp, nq, o, et, es, flat) {
-                // A shadow that misses the part of b in front of p takes no slot.
-                Some(Some(shadow))
-                    if shadow.sides.get(..shadow.count).unwrap_or_default().iter().any(|&side| start.outside(side)) => {
-                }
-                Some(Some(shadow)) => match shadows.get_mut(found) {
-                    Some(slot) => {
-                        *slot = shadow;
-                        found += 1;
+                let corners = match caster {
+                    Caster::Polygon(corners) => corners,
+                    // One sphere, wholly on p's side of b's plane (with a relative margin): every
+                    // ray from p that meets it does so before b's plane, so its shadow is the cone
+                    // of directions to it, taken from every piece (`polygon_past_sphere`).
+                    Caster::Sphere(ball) => {
+                        let margin = ball.radius * T::GEOMETRY_TOLERANCE.sqrt();
+                        overflow |= sphere.is_some() || !(nq.dot(ball.center - o) > ball.radius + margin);
+                        sphere = Some(ball);
+                        return;
                     }
+                };
+                match shadow_of(corners, p, hp, nq, o, et, es, flat) {
+                    // A shadow that misses the part of b in front of p takes no slot.
+                    Some(Some(shadow))
+                        if shadow
+                            .sides
+                            .get(..shadow.count)
+                            .unwrap_or_default()
+                            .iter()
+                            .any(|&side| start.outside(side)) => {}
+                    Some(Some(shadow)) => match shadows.get_mut(found) {
+                        Some(slot) => {
+                            *slot = shadow;
+                            found += 1;
+                        }
+                        None => overflow = true,
+                    },
+                    Some(None) => {}
                     None => overflow = true,
-                },
-                Some(None) => {}
-                None => overflow = true,
-            }
-        });
+                }
+            });
         if !supported || overflow {
             return None;
         }

@@ -321,7 +321,42 @@ where
             crate::singular::identical_unchecked(a, settings.singular_order, occluders).map(exact)
         }
         Route::Separate => separate(&mut pair, settings).map(exact),
+        Route::ContactPastShadows => {
+            #[cfg(feature = "closed-form")]
+            if let Some(value) = contact_past_shadows(a, b, settings.order, occluders)? {
+                return Ok(Some(value));
+            }
+            separate(&mut pair, settings).map(exact)
+        }
     }
+}
+
+/// A touching flat pair across flat occluders ([`Route::ContactPastShadows`]) at `order`: the
+/// unoccluded exchange by the contour form less the part the occluders block
+/// ([`crate::boundary::blocked_unchecked`]), as `dispatch` returns it (the contour form's
+/// rounding bound with it); `None` where either part does not apply.
+#[cfg(feature = "closed-form")]
+#[inline(never)]
+pub(crate) fn contact_past_shadows<T, SA, SB, O>(
+    a: &Patch<'_, T, SA>,
+    b: &Patch<'_, T, SB>,
+    order: usize,
+    occluders: &O,
+) -> Result<Option<(T, u64, T)>, PdmError>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
+    let Some(Ok((unoccluded, count, rounding, _))) = flat_pair(a, b, order, &()) else { return Ok(None) };
+    if crate::bounds::cancels(unoccluded, rounding) {
+        return Ok(None);
+    }
+    let Some((blocked, blocked_count)) = crate::boundary::blocked_unchecked(a, b, order, occluders)? else {
+        return Ok(None);
+    };
+    Ok(Some((unoccluded - blocked, count.saturating_add(blocked_count), rounding)))
 }
 
 /// A separate pair: the plain sum where the integrand is smooth, else the boundary path. Where

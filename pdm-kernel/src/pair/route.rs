@@ -27,6 +27,11 @@ pub(crate) enum Route<T> {
     Identical { gap: T, collapsed: bool },
     /// Separate patches: [`PairContext::separate_route`] decides on the samples.
     Separate,
+    /// Parallelograms that touch, across flat convex occluders and spheres
+    /// ([`contact_across_shadows`]): the unoccluded exchange by the contour form less the part
+    /// the occluders block (`boundary/blocked.rs`), where that applies; else the boundary path
+    /// over the whole pair as [`Route::Separate`].
+    ContactPastShadows,
 }
 
 /// When a touching pair that an occluder may cut is split ([`Route::SplitContact`]).
@@ -61,7 +66,7 @@ where
             let may_cut = occluders.may_block_between(&a.enclosing_ball(), &b.enclosing_ball());
             // At any depth: the transforms' occlusion test per node is what this avoids.
             if may_cut && contact_across_shadows(a, b, occluders) {
-                Route::Separate
+                Route::ContactPastShadows
             } else if splits.allowed && (splits.collapsed || !collapsed) && may_cut {
                 Route::SplitContact
             } else {
@@ -75,7 +80,7 @@ where
 
 /// Whether a touching pair that an occluder may cut takes the boundary path whole instead of
 /// [`Route::SplitContact`]: both patches parallelograms and the occluders flat convex polygons
-/// and spheres, at least one polygon ([`Occluder::shadow_casters`], asked from a's centre). The inner integral from
+/// and spheres, at least one polygon ([`Occluder::shadow_casters`], asked from a's ball). The inner integral from
 /// every outer point is then exact however close the point comes to the contact
 /// (`boundary/shadows.rs`), and the outer rule is graded towards b (`boundary::outer_cells`);
 /// splitting cells along the contact instead ran the regularising transforms with the
@@ -95,7 +100,7 @@ where
         // With spheres alone the contact is split as before: its separate sub-pairs get the
         // sphere's outer events (exponential), which the whole pair's outer rule would not.
         let mut polygons = false;
-        let casters = occluders.shadow_casters(a.enclosing_ball().center, &corners, &b.enclosing_ball(), &mut |c| {
+        let casters = occluders.shadow_casters(&a.enclosing_ball(), &corners, &b.enclosing_ball(), &mut |c| {
             polygons |= matches!(c, crate::visibility::Caster::Polygon(_));
         });
         casters && polygons

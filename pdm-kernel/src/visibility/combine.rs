@@ -67,12 +67,18 @@ impl<T: Real> Occluder<T> for AnyOccluder<T> {
         }
     }
     #[cfg(feature = "closed-form")]
-    fn shadow_casters(&self, p: Vec3<T>, b: &[Vec3<T>], bounds: &Ball<T>, out: &mut dyn FnMut(Caster<'_, T>)) -> bool {
+    fn shadow_casters(
+        &self,
+        from: &Ball<T>,
+        b: &[Vec3<T>],
+        bounds: &Ball<T>,
+        out: &mut dyn FnMut(Caster<'_, T>),
+    ) -> bool {
         match self {
-            Self::Parallelogram(o) => o.shadow_casters(p, b, bounds, out),
-            Self::Quadrilateral(o) => o.shadow_casters(p, b, bounds, out),
-            Self::Sphere(o) => o.shadow_casters(p, b, bounds, out),
-            _ => !self.may_block_between(&Ball { center: p, radius: T::ZERO }, bounds),
+            Self::Parallelogram(o) => o.shadow_casters(from, b, bounds, out),
+            Self::Quadrilateral(o) => o.shadow_casters(from, b, bounds, out),
+            Self::Sphere(o) => o.shadow_casters(from, b, bounds, out),
+            _ => !self.may_block_between(from, bounds),
         }
     }
     #[cfg(feature = "closed-form")]
@@ -136,8 +142,14 @@ impl<T: Real, O: Occluder<T> + ?Sized> Occluder<T> for &O {
         (**self).hides_ball_from(p, b)
     }
     #[cfg(feature = "closed-form")]
-    fn shadow_casters(&self, p: Vec3<T>, b: &[Vec3<T>], bounds: &Ball<T>, out: &mut dyn FnMut(Caster<'_, T>)) -> bool {
-        (**self).shadow_casters(p, b, bounds, out)
+    fn shadow_casters(
+        &self,
+        from: &Ball<T>,
+        b: &[Vec3<T>],
+        bounds: &Ball<T>,
+        out: &mut dyn FnMut(Caster<'_, T>),
+    ) -> bool {
+        (**self).shadow_casters(from, b, bounds, out)
     }
     #[cfg(feature = "closed-form")]
     fn shadow_sphere(&self, a: &Ball<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
@@ -165,8 +177,14 @@ impl<T: Real, O: Occluder<T>> Occluder<T> for [O] {
         self.iter().any(|o| o.hides_ball_from(p, b))
     }
     #[cfg(feature = "closed-form")]
-    fn shadow_casters(&self, p: Vec3<T>, b: &[Vec3<T>], bounds: &Ball<T>, out: &mut dyn FnMut(Caster<'_, T>)) -> bool {
-        self.iter().all(|o| o.shadow_casters(p, b, bounds, out))
+    fn shadow_casters(
+        &self,
+        from: &Ball<T>,
+        b: &[Vec3<T>],
+        bounds: &Ball<T>,
+        out: &mut dyn FnMut(Caster<'_, T>),
+    ) -> bool {
+        self.iter().all(|o| o.shadow_casters(from, b, bounds, out))
     }
     #[cfg(feature = "closed-form")]
     fn shadow_sphere(&self, a: &Ball<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
@@ -194,8 +212,14 @@ impl<T: Real, O: Occluder<T>, const N: usize> Occluder<T> for [O; N] {
         self.as_slice().hides_ball_from(p, b)
     }
     #[cfg(feature = "closed-form")]
-    fn shadow_casters(&self, p: Vec3<T>, b: &[Vec3<T>], bounds: &Ball<T>, out: &mut dyn FnMut(Caster<'_, T>)) -> bool {
-        self.as_slice().shadow_casters(p, b, bounds, out)
+    fn shadow_casters(
+        &self,
+        from: &Ball<T>,
+        b: &[Vec3<T>],
+        bounds: &Ball<T>,
+        out: &mut dyn FnMut(Caster<'_, T>),
+    ) -> bool {
+        self.as_slice().shadow_casters(from, b, bounds, out)
     }
     #[cfg(feature = "closed-form")]
     fn shadow_sphere(&self, a: &Ball<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
@@ -223,8 +247,14 @@ impl<T: Real, O: Occluder<T>, const N: usize> Occluder<T> for heapless::Vec<O, N
         self.as_slice().hides_ball_from(p, b)
     }
     #[cfg(feature = "closed-form")]
-    fn shadow_casters(&self, p: Vec3<T>, b: &[Vec3<T>], bounds: &Ball<T>, out: &mut dyn FnMut(Caster<'_, T>)) -> bool {
-        self.as_slice().shadow_casters(p, b, bounds, out)
+    fn shadow_casters(
+        &self,
+        from: &Ball<T>,
+        b: &[Vec3<T>],
+        bounds: &Ball<T>,
+        out: &mut dyn FnMut(Caster<'_, T>),
+    ) -> bool {
+        self.as_slice().shadow_casters(from, b, bounds, out)
     }
     #[cfg(feature = "closed-form")]
     fn shadow_sphere(&self, a: &Ball<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
@@ -252,8 +282,14 @@ impl<T: Real, O: Occluder<T>> Occluder<T> for Option<O> {
         self.as_ref().is_some_and(|o| o.hides_ball_from(p, b))
     }
     #[cfg(feature = "closed-form")]
-    fn shadow_casters(&self, p: Vec3<T>, b: &[Vec3<T>], bounds: &Ball<T>, out: &mut dyn FnMut(Caster<'_, T>)) -> bool {
-        self.as_ref().is_none_or(|o| o.shadow_casters(p, b, bounds, out))
+    fn shadow_casters(
+        &self,
+        from: &Ball<T>,
+        b: &[Vec3<T>],
+        bounds: &Ball<T>,
+        out: &mut dyn FnMut(Caster<'_, T>),
+    ) -> bool {
+        self.as_ref().is_none_or(|o| o.shadow_casters(from, b, bounds, out))
     }
     #[cfg(feature = "closed-form")]
     fn shadow_sphere(&self, a: &Ball<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
@@ -281,8 +317,14 @@ impl<T: Real, A: Occluder<T>, B: Occluder<T>> Occluder<T> for (A, B) {
         self.0.hides_ball_from(p, b) || self.1.hides_ball_from(p, b)
     }
     #[cfg(feature = "closed-form")]
-    fn shadow_casters(&self, p: Vec3<T>, b: &[Vec3<T>], bounds: &Ball<T>, out: &mut dyn FnMut(Caster<'_, T>)) -> bool {
-        self.0.shadow_casters(p, b, bounds, out) && self.1.shadow_casters(p, b, bounds, out)
+    fn shadow_casters(
+        &self,
+        from: &Ball<T>,
+        b: &[Vec3<T>],
+        bounds: &Ball<T>,
+        out: &mut dyn FnMut(Caster<'_, T>),
+    ) -> bool {
+        self.0.shadow_casters(from, b, bounds, out) && self.1.shadow_casters(from, b, bounds, out)
     }
     #[cfg(feature = "closed-form")]
     fn shadow_sphere(&self, a: &Ball<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {
@@ -312,10 +354,16 @@ impl<T: Real, A: Occluder<T>, B: Occluder<T>, C: Occluder<T>> Occluder<T> for (A
         self.0.hides_ball_from(p, b) || self.1.hides_ball_from(p, b) || self.2.hides_ball_from(p, b)
     }
     #[cfg(feature = "closed-form")]
-    fn shadow_casters(&self, p: Vec3<T>, b: &[Vec3<T>], bounds: &Ball<T>, out: &mut dyn FnMut(Caster<'_, T>)) -> bool {
-        self.0.shadow_casters(p, b, bounds, out)
-            && self.1.shadow_casters(p, b, bounds, out)
-            && self.2.shadow_casters(p, b, bounds, out)
+    fn shadow_casters(
+        &self,
+        from: &Ball<T>,
+        b: &[Vec3<T>],
+        bounds: &Ball<T>,
+        out: &mut dyn FnMut(Caster<'_, T>),
+    ) -> bool {
+        self.0.shadow_casters(from, b, bounds, out)
+            && self.1.shadow_casters(from, b, bounds, out)
+            && self.2.shadow_casters(from, b, bounds, out)
     }
     #[cfg(feature = "closed-form")]
     fn shadow_sphere(&self, a: &Ball<T>, b: &Ball<T>) -> Option<Option<Ball<T>>> {

@@ -133,17 +133,25 @@ pub trait Occluder<T: Real> {
         (!self.may_block_between(a, b)).then_some(None)
     }
 
-    /// The occluders that may cut a segment from the point `p` to the flat convex polygon `b`
-    /// (inside `bounds`), where each is a flat convex polygon or a sphere: passes each to `out`
+    /// The occluders that may cut a segment from a point of the ball `from` (a point: radius
+    /// zero) to the flat convex polygon `b` (inside `bounds`), where each is a flat convex
+    /// polygon or a sphere: passes each to `out`
     /// ([`Caster`]) and returns `true`; or returns `false` where some part that may cut is
-    /// neither. `boundary/` then takes the inner integral over a parallelogram b from p in
-    /// closed form: b less the polygons' shadows, less one sphere's cone of directions. The
+    /// neither. `boundary/` then takes the inner integral over a parallelogram b from a point p
+    /// in closed form (b less the polygons' shadows, less one sphere's cone of directions), and
+    /// asked from a whole flat outer patch places the polygons' outer events into its rule. The
     /// default passes nothing and says whether nothing may cut
-    /// ([`may_block_between`](Occluder::may_block_between) from p to `bounds`).
+    /// ([`may_block_between`](Occluder::may_block_between) from `from` to `bounds`).
     #[cfg(feature = "closed-form")]
-    fn shadow_casters(&self, p: Vec3<T>, b: &[Vec3<T>], bounds: &Ball<T>, out: &mut dyn FnMut(Caster<'_, T>)) -> bool {
+    fn shadow_casters(
+        &self,
+        from: &Ball<T>,
+        b: &[Vec3<T>],
+        bounds: &Ball<T>,
+        out: &mut dyn FnMut(Caster<'_, T>),
+    ) -> bool {
         let _ = (b, out);
-        !self.may_block_between(&Ball { center: p, radius: T::ZERO }, bounds)
+        !self.may_block_between(from, bounds)
     }
 
     /// Conservative culling the other way: `true` only if every segment from `p` to a point of

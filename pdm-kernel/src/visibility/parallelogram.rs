@@ -32,8 +32,14 @@ impl<T: Real> Occluder<T> for Parallelogram<T> {
         ball_may_cut_pair(center, radius, a, b)
     }
     #[cfg(feature = "closed-form")]
-    fn shadow_casters(&self, p: Vec3<T>, _b: &[Vec3<T>], bounds: &Ball<T>, out: &mut dyn FnMut(Caster<'_, T>)) -> bool {
-        if self.may_block_between(&Ball { center: p, radius: T::ZERO }, bounds) {
+    fn shadow_casters(
+        &self,
+        from: &Ball<T>,
+        _b: &[Vec3<T>],
+        bounds: &Ball<T>,
+        out: &mut dyn FnMut(Caster<'_, T>),
+    ) -> bool {
+        if self.may_block_between(from, bounds) {
             let (o, et, es) = (self.origin, self.edge_t, self.edge_s);
             out(Caster::Polygon(&[o, o + et, o + et + es, o + es]));
         }

@@ -42,8 +42,14 @@ impl<T: Real> Occluder<T> for Quadrilateral<T> {
         ball_may_cut_pair(center, radius, a, b)
     }
     #[cfg(feature = "closed-form")]
-    fn shadow_casters(&self, p: Vec3<T>, _b: &[Vec3<T>], bounds: &Ball<T>, out: &mut dyn FnMut(Caster<'_, T>)) -> bool {
-        if self.may_block_between(&Ball { center: p, radius: T::ZERO }, bounds) {
+    fn shadow_casters(
+        &self,
+        from: &Ball<T>,
+        _b: &[Vec3<T>],
+        bounds: &Ball<T>,
+        out: &mut dyn FnMut(Caster<'_, T>),
+    ) -> bool {
+        if self.may_block_between(from, bounds) {
             out(Caster::Polygon(&self.corners));
         }
         true

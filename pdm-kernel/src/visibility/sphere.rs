@@ -18,19 +18,26 @@ impl<T: Real> Occluder<T> for Sphere<T> {
         let cuts = self.may_block_between(a, b);
         Some(cuts.then_some(Ball { center: self.center, radius: self.radius }))
     }
-    /// The sphere itself where it may cut a segment from p to the convex polygon b: nothing
-    /// where it lies outside the cone from p to b's ball, or beyond one face plane of their
-    /// hull (the pyramid with apex p over b: b's plane and the planes through p and each side
-    /// of b) by its radius. A room's lamp, which the ball of a whole wall takes in, passes the
-    /// second test from most points of the room.
+    /// The sphere itself where it may cut a segment from a point of `from` to the convex
+    /// polygon b: nothing where it lies outside the hull of `from` and b's ball, or, from a
+    /// point p (`from` of radius zero), beyond one face plane of the pyramid with apex p over b
+    /// (b's plane and the planes through p and each side of b) by its radius. A room's lamp,
+    /// which the ball of a whole wall takes in, passes the second test from most points of the
+    /// room.
     #[cfg(feature = "closed-form")]
-    fn shadow_casters(&self, p: Vec3<T>, b: &[Vec3<T>], bounds: &Ball<T>, out: &mut dyn FnMut(Caster<'_, T>)) -> bool {
+    fn shadow_casters(
+        &self,
+        from: &Ball<T>,
+        b: &[Vec3<T>],
+        bounds: &Ball<T>,
+        out: &mut dyn FnMut(Caster<'_, T>),
+    ) -> bool {
         let ball = Ball { center: self.center, radius: self.radius };
-        if !self.may_block_between(&Ball { center: p, radius: T::ZERO }, bounds) {
+        if !self.may_block_between(from, bounds) {
             return true;
         }
-        let n = b.len();
-        if n < 3 {
+        let (p, n) = (from.center, b.len());
+        if n < 3 || from.radius != T::ZERO {
             out(Caster::Sphere(ball));
             return true;
         }

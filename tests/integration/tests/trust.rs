@@ -907,18 +907,16 @@ mod polygon_shadows {
         let (a, b) = (Patch::whole(&bottom).unwrap(), Patch::whole(&top).unwrap());
         let half = 0.5 * exact::parallel_rectangles(1.0, 1.0, 1.0);
         for screen in screens() {
-            for order in [4, 8] {
+            // The outer rule has the screen's events (lines where its shadow edge passes b's
+            // corners: a's edges here) and converges exponentially with the order.
+            for (order, bound) in [(4, 1e-4), (8, 1e-9), (12, 1e-14)] {
                 let settings = PairSettings { order, singular_order: order, boundaries: true };
                 for (name, e) in [
                     ("a → b", pair_exchange::<f64, _, _, _, 256>(&a, &b, settings, &screen).unwrap()),
                     ("b → a", pair_exchange::<f64, _, _, _, 256>(&b, &a, settings, &screen).unwrap()),
                 ] {
-                    println!("order {order} {name}: {:.1e} off", rel(e.value, half));
-                    assert!(
-                        rel(e.value, half) < 1e-12 || order < 8,
-                        "order {order} {name}: {:e} against {half:e}",
-                        e.value
-                    );
+                    println!("order {order} {name}: {:.1e} off, {} evaluations", rel(e.value, half), e.evaluations);
+                    assert!(rel(e.value, half) < bound, "order {order} {name}: {:e} against {half:e}", e.value);
                 }
             }
             for tol in [1e-4, 1e-10] {
@@ -998,6 +996,85 @@ mod polygon_shadows {
             );
             assert!(error <= estimate, "tol {tol:e}: {error:e} off, estimate {estimate:e}");
             assert!(!e.converged || error <= tol * half, "tol {tol:e}: {error:e} off");
+        }
+    }
+
+    /// A closed box floating in a closed room: every row of the enclosure sums to 1 (an
+    /// identity, no reference code). The room's faces touch each other along edges with the
+    /// box between them (the contour form less the blocked part, `boundary/blocked.rs`), face
+    /// pairs across the room see past the box (its facets' outer events,
+    /// `boundary/polygon_events.rs`), and the box's facets see the room directly. Before both,
+    /// the ceiling's row missed 1 by 6e-6 with the pairs above the tolerance.
+    #[test]
+    fn a_box_in_a_room_leaves_every_row_summing_to_one() {
+        let p = |o: [f64; 3], t: [f64; 3], s: [f64; 3]| {
+            AnyOccluder::Parallelogram(
+                Parallelogram::new(vec3(o[0], o[1], o[2]), vec3(t[0], t[1], t[2]), vec3(s[0], s[1], s[2])).unwrap(),
+            )
+        };
+        let (x0, y0, z0, dx, dy, dz) = (1.5, 2.0, 0.5, 1.0, 1.0, 0.7);
+        let surfaces = [
+            p([0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 5.0, 0.0]),
+            p([0.0, 0.0, 2.5], [0.0, 5.0, 0.0], [4.0, 0.0, 0.0]),
+            p([0.0, 0.0, 0.0], [0.0, 0.0, 2.5], [4.0, 0.0, 0.0]),
+            p([0.0, 5.0, 0.0], [4.0, 0.0, 0.0], [0.0, 0.0, 2.5]),
+            p([0.0, 0.0, 0.0], [0.0, 5.0, 0.0], [0.0, 0.0, 2.5]),
+            p([4.0, 0.0, 0.0], [0.0, 0.0, 2.5], [0.0, 5.0, 0.0]),
+            p([x0, y0, z0 + dz], [dx, 0.0, 0.0], [0.0, dy, 0.0]),
+            p([x0, y0, z0], [0.0, dy, 0.0], [dx, 0.0, 0.0]),
+            p([x0, y0, z0], [dx, 0.0, 0.0], [0.0, 0.0, dz]),
+            p([x0, y0 + dy, z0], [0.0, 0.0, dz], [dx, 0.0, 0.0]),
+            p([x0, y0, z0], [0.0, 0.0, dz], [0.0, dy, 0.0]),
+            p([x0 + dx, y0, z0], [0.0, dy, 0.0], [0.0, 0.0, dz]),
+        ];
+        let surface = |k: usize| match &surfaces[k] {
+            AnyOccluder::Parallelogram(s) => s,
+            _ => unreachable!(),
+        };
+        let n = surfaces.len();
+        // |e_t × e_s| of each, in the order above.
+        let areas = [20.0, 20.0, 10.0, 10.0, 12.5, 12.5, dx * dy, dx * dy, dx * dz, dx * dz, dy * dz, dy * dz];
+        let area = |k: usize| areas[k];
+        for (mode, tol, bound) in [("order 10", None, 1e-9), ("tolerance 1e-10", Some(1e-10), 1e-9)] {
+            let mut rows = vec![0.0; n];
+            let mut errors = vec![0.0; n];
+            let started = std::time::Instant::now();
+            for i in 0..n {
+                for j in i + 1..n {
+                    let others: Vec<AnyOccluder<f64>> =
+                        (0..n).filter(|&k| k != i && k != j).map(|k| surfaces[k]).collect();
+                    let (a, b) = (Patch::whole(surface(i)).unwrap(), Patch::whole(surface(j)).unwrap());
+                    let (value, error) = match tol {
+                        None => {
+                            let settings = PairSettings { order: 10, singular_order: 10, boundaries: true };
+                            (
+                                pair_exchange::<f64, _, _, _, 256>(&a, &b, settings, others.as_slice()).unwrap().value,
+                                0.0,
+                            )
+                        }
+                        Some(tol) => {
+                            let e =
+                                adaptive_exchange::<f64, _, _, _, 1024>(&a, &b, Adaptive::new(tol), others.as_slice())
+                                    .unwrap();
+                            assert!(e.converged, "{mode}: pair {i}-{j} not converged, estimate {:e}", e.error.unwrap());
+                            (e.value, e.error.unwrap())
+                        }
+                    };
+                    rows[i] += value / area(i);
+                    rows[j] += value / area(j);
+                    errors[i] += error / area(i);
+                    errors[j] += error / area(j);
+                }
+            }
+            println!("{mode}: {:.2} s", started.elapsed().as_secs_f64());
+            for k in 0..n {
+                println!("  row {k}: misses 1 by {:.1e} (estimates {:.1e})", rows[k] - 1.0, errors[k]);
+                assert!((rows[k] - 1.0).abs() < bound, "{mode}: row {k} sums to {}", rows[k]);
+                assert!(
+                    tol.is_none() || (rows[k] - 1.0).abs() <= errors[k] + 1e-14,
+                    "{mode}: row {k} beyond its estimates"
+                );
+            }
         }
     }
 }

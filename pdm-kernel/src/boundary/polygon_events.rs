@@ -1,0 +1,483 @@
+//! Outer events across flat convex occluders: the lines on a flat outer patch a where J(p) over
+//! a parallelogram b changes its structure when the occluders are one convex polygon, or the
+//! facets of one convex solid.
+//!
+//! J(p) is Lambert's form over b less the union of the occluders' shadows (`shadows.rs`); it is
+//! analytic in p as long as the combinatorial structure of that region stays the same. For one
+//! convex polygon O (or a convex solid's facets, whose shadows' union is the solid's shadow)
+//! the structure changes only where
+//!
+//! * a shadow vertex crosses an edge of b: p lies in the plane through a vertex v of O and b's
+//!   edge, on the part of it where the ray from p through v meets the edge segment (the visible
+//!   area changes like δ² on one side);
+//! * a shadow edge passes through a corner c of b: p lies in the plane through c and an edge of
+//!   O, on the part where the segment from p to c crosses that edge (likewise δ²);
+//! * p crosses O's own plane: the shadow folds through a segment, its area is ∝ |δ| (a kink);
+//!   for a solid, a facet turns towards or away from p and the silhouette changes;
+//! * p crosses b's plane (b starts facing p).
+//!
+//! All are planes, so on a flat a they are lines in a's parameters, each with a guard (the
+//! double wedge about the line through v, or through c, where the event is real) placed into
+//! the outer rule as [`Events`] places conics. A vertex or edge of O lying on or behind b's
+//! plane is its own shadow there and moves with nothing; it gives no event. The part of O
+//! beyond p's height casts its shadow beyond every bounded b, so p passing a vertex's height
+//! is no event either.
+//!
+//! Where two separate occluders' shadows can meet on b, J also changes where a vertex of one's
+//! shadow crosses an edge of the other's (planes) and where two shadow edges cross on an edge
+//! of b (three lines meeting: quadric surfaces), dozens to hundreds of curves for two boxes, most
+//! of them inside the union of the shadows where nothing changes. Those pairs are declined
+//! (`None`): the outer rule samples across their events as before. Occluders that cannot cut
+//! any segment from a to b (a separating plane between the occluder and the hull of a and b)
+//! are left out first, so a room's walls do not count against a pair of other walls.
+
+use super::*;
+use crate::visibility::{Caster, Quadric};
+
+/// Most event lines of one pair across polygons: a box's eight vertices against b's four
+/// edges, its twelve edges against b's four corners, its six facet planes (86 before the guards
+/// cull those that miss a), with room for a pentagonal solid.
+pub(crate) const MAX_POLYGON_EVENT_CURVES: usize = 96;
+
+/// Breaks in s (each line crosses a's two t-edges and ends on its two guard lines) and along
+/// one outer line (one per line), ends included.
+const POLYGON_S_BREAKS: usize = 4 * MAX_POLYGON_EVENT_CURVES + 2;
+const POLYGON_T_BREAKS: usize = MAX_POLYGON_EVENT_CURVES + 2;
+
+/// A parallelogram: its affine map (origin, e_t, e_s) and parameter rectangle.
+pub(super) type MappedRect<T> = ((Vec3<T>, Vec3<T>, Vec3<T>), ParamRect<T>);
+
+/// The events of a pair across flat convex occluders.
+pub(super) type PolygonEvents<T> = Events<T, MAX_POLYGON_EVENT_CURVES, POLYGON_S_BREAKS, POLYGON_T_BREAKS>;
+
+/// Most facets of the one convex solid (a box has six).
+const MAX_FACETS: usize = 12;
+
+/// Most polygons that may cut from a's ball ([`Occluder::shadow_casters`]), of all solids: a
+/// room's walls, a table's and a cabinet's facets.
+const MAX_CASTERS: usize = 32;
+
+/// Most corners of one facet ([`Caster::Polygon`]: a quadrilateral, a triangle as one).
+const FACET_CORNERS: usize = 6;
+
+/// Most distinct vertices and edges of the solid.
+const MAX_VERTICES: usize = 2 * MAX_FACETS + 8;
+const MAX_EDGES: usize = MAX_FACETS * FACET_CORNERS / 2 + 8;
+
+/// The occluder polygons that may cut the pair, with their distinct vertices and edges.
+struct Solid<T> {
+    facets: [([Vec3<T>; FACET_CORNERS], usize); MAX_FACETS],
+    n_facets: usize,
+    vertices: [Vec3<T>; MAX_VERTICES],
+    n_vertices: usize,
+    /// Each edge once (end points in either order), and how many facets have it.
+    edges: [(Vec3<T>, Vec3<T>, u8); MAX_EDGES],
+    n_edges: usize,
+}
+
+impl<T: Real> Solid<T> {
+    fn new() -> Self {
+        Self {
+            facets: [([Vec3::ZERO; FACET_CORNERS], 0); MAX_FACETS],
+            n_facets: 0,
+            vertices: [Vec3::ZERO; MAX_VERTICES],
+            n_vertices: 0,
+            edges: [(Vec3::ZERO, Vec3::ZERO, 0); MAX_EDGES],
+            n_edges: 0,
+        }
+    }
+
+    /// The facets connected (by shared edges) to the `casters` that a segment from a to b can
+    /// cross (the flag), whether those can be crossed or not: the solid whose shadow the
+    /// crossed facets' shadows make up. `Some(empty)` where none can be crossed; `None` where
+    /// those that can lie on more than one connected set, or on overflow.
+    fn of_cutting_component(casters: &[([Vec3<T>; FACET_CORNERS], usize, bool)]) -> Option<Self> {
+        let corners = |k: usize| casters.get(k).map(|(c, n, _)| c.get(..*n).unwrap_or_default()).unwrap_or_default();
+        let share_edge = |i: usize, j: usize| {
+            let (p, q) = (corners(i), corners(j));
+            let edge = |c: &[Vec3<T>], k: usize| (c.get(k).copied(), c.get((k + 1) % c.len().max(1)).copied());
+            (0..p.len()).any(|k| {
+                let (v, w) = edge(p, k);
+                v != w && (0..q.len()).any(|m| edge(q, m) == (w, v) || edge(q, m) == (v, w))
+            })
+        };
+        // Component labels by repeated relaxation (a few dozen polygons).
+        let mut label = [0usize; MAX_CASTERS];
+        for (k, l) in label.iter_mut().enumerate() {
+            *l = k;
+        }
+        let n = casters.len();
+        let mut changed = true;
+        while changed {
+            changed = false;
+            for i in 0..n {
+                for j in 0..n {
+                    let (Some(&li), Some(&lj)) = (label.get(i), label.get(j)) else { continue };
+                    if lj < li && share_edge(i, j) {
+                        if let Some(l) = label.get_mut(i) {
+                            *l = lj;
+                        }
+                        changed = true;
+                    }
+                }
+            }
+        }
+        let mut cutting = casters.iter().zip(label.iter()).filter(|((_, _, crossed), _)| *crossed).map(|(_, &l)| l);
+        let mut solid = Self::new();
+        let Some(component) = cutting.next() else { return Some(solid) };
+        if cutting.any(|l| l != component) {
+            return None;
+        }
+        for (k, _) in label.iter().take(n).enumerate().filter(|(_, &l)| l == component) {
+            solid.push(corners(k))?;
+        }
+        Some(solid)
+    }
+
+    fn facets(&self) -> impl Iterator<Item = &[Vec3<T>]> {
+        self.facets.iter().take(self.n_facets).map(|(c, n)| c.get(..*n).unwrap_or_default())
+    }
+
+    fn vertices(&self) -> &[Vec3<T>] {
+        self.vertices.get(..self.n_vertices).unwrap_or_default()
+    }
+
+    fn edges(&self) -> &[(Vec3<T>, Vec3<T>, u8)] {
+        self.edges.get(..self.n_edges).unwrap_or_default()
+    }
+
+    /// Adds a facet (repeated corners dropped) with its vertices and edges; `None` on overflow.
+    fn push(&mut self, corners: &[Vec3<T>]) -> Option<()> {
+        let mut facet = [Vec3::ZERO; FACET_CORNERS];
+        let mut n = 0usize;
+        for &c in corners {
+            if n > 0 && facet.get(n - 1) == Some(&c) {
+                continue;
+            }
+            *facet.get_mut(n)? = c;
+            n += 1;
+        }
+        if n > 1 && facet.first() == facet.get(n - 1) {
+            n -= 1;
+        }
+        if n < 3 {
+            return Some(()); // no area, no shadow
+        }
+        *self.facets.get_mut(self.n_facets)? = (facet, n);
+        self.n_facets += 1;
+        for k in 0..n {
+            let (&v, &w) = (facet.get(k)?, facet.get((k + 1) % n)?);
+            if !self.vertices().contains(&v) {
+                *self.vertices.get_mut(self.n_vertices)? = v;
+                self.n_vertices += 1;
+            }
+            match self.edges.iter_mut().take(self.n_edges).find(|e| (e.0 == v && e.1 == w) || (e.0 == w && e.1 == v)) {
+                Some(e) => e.2 = e.2.saturating_add(1),
+                None => {
+                    *self.edges.get_mut(self.n_edges)? = (v, w, 1);
+                    self.n_edges += 1;
+                }
+            }
+        }
+        Some(())
+    }
+
+    /// Where the facets are several: whether they are facets of one convex solid H (the hull of
+    /// their vertices) whose shadow their shadows make up for segments from a to b (corners
+    /// `ac`, `bc`). Every vertex must lie on one side of every facet's plane (each facet is then
+    /// a face of H); and either every edge belongs to two facets (H is closed), or no segment
+    /// from a to b crosses the part of H's surface that no facet covers. That part's vertices
+    /// are all on edges that belong to one facet (around such a vertex, covered and uncovered
+    /// faces meet at one), so it lies in the hull of those vertices, which must be separated
+    /// from the hull of a and b ([`separated`]). A segment that meets H's interior crosses its
+    /// surface twice, at least once in a facet. A facet the caller left out as unable to cut
+    /// (a scene's culled box side) is such an uncovered part.
+    fn convex(&self, ac: &[Vec3<T>; 4], bc: &[Vec3<T>; 4], tolerance: T) -> bool {
+        for facet in self.facets() {
+            let Some((origin, normal)) = plane_of(facet) else { return false };
+            let (mut above, mut below) = (false, false);
+            for &v in self.vertices() {
+                let h = normal.dot(v - origin);
+                above |= h > tolerance;
+                below |= h < -tolerance;
+            }
+            if above && below {
+                return false;
+            }
+        }
+        if self.edges().iter().any(|e| e.2 > 2) {
+            return false;
+        }
+        let open = || self.edges().iter().filter(|e| e.2 == 1);
+        if open().next().is_none() {
+            return true;
+        }
+        let mut rim = [Vec3::ZERO; MAX_VERTICES];
+        let mut n = 0usize;
+        for &(v, w, _) in open() {
+            for x in [v, w] {
+                if !rim.get(..n).unwrap_or_default().contains(&x) {
+                    let Some(slot) = rim.get_mut(n) else { return false };
+                    *slot = x;
+                    n += 1;
+                }
+            }
+        }
+        let rim = rim.get(..n).unwrap_or_default();
+        let edges = open().map(|&(v, w, _)| w - v);
+        let normals = open().flat_map(|&(v, w, _)| rim.iter().map(move |&x| (w - v).cross(x - v)));
+        separated(rim, edges, normals, ac, bc, tolerance)
+    }
+}
+
+/// The distance from the segment [c0, c1] to the convex polygon (zero where they meet).
+fn segment_to_polygon<T: Real>(c0: Vec3<T>, c1: Vec3<T>, polygon: &[Vec3<T>]) -> T {
+    let Some((o, n)) = plane_of(polygon) else { return T::ZERO };
+    let count = polygon.len();
+    let side = |k: usize| Some((*polygon.get(k)?, *polygon.get((k + 1) % count)?));
+    let inside = |x: Vec3<T>| (0..count).all(|k| side(k).is_none_or(|(v, w)| (w - v).cross(x - v).dot(n) >= T::ZERO));
+    let (h0, h1) = (n.dot(c0 - o), n.dot(c1 - o));
+    if h0 * h1 <= T::ZERO && h0 != h1 && inside(c0 + (c1 - c0).scale(h0 / (h0 - h1))) {
+        return T::ZERO;
+    }
+    let to_point = |x: Vec3<T>| {
+        let h = n.dot(x - o);
+        if inside(x - n.scale(h)) {
+            h.abs()
+        } else {
+            (0..count).filter_map(side).fold(T::MAX, |m, (v, w)| m.min(segment_to_segment(x, x, v, w)))
+        }
+    };
+    let edges = (0..count).filter_map(side).fold(T::MAX, |m, (v, w)| m.min(segment_to_segment(c0, c1, v, w)));
+    to_point(c0).min(to_point(c1)).min(edges)
+}
+
+/// The distance between the segments [p0, p1] and [q0, q1] (either may be a point): the closest
+/// pair of the lines clamped to the segments, and each end against the other segment.
+fn segment_to_segment<T: Real>(p0: Vec3<T>, p1: Vec3<T>, q0: Vec3<T>, q1: Vec3<T>) -> T {
+    let to_segment = |x: Vec3<T>, a: Vec3<T>, b: Vec3<T>| {
+        let d = b - a;
+        let dd = d.norm2();
+        let tau = if dd > T::ZERO { ((x - a).dot(d) / dd).max(T::ZERO).min(T::ONE) } else { T::ZERO };
+        (x - a - d.scale(tau)).norm()
+    };
+    let ends =
+        to_segment(p0, q0, q1).min(to_segment(p1, q0, q1)).min(to_segment(q0, p0, p1)).min(to_segment(q1, p0, p1));
+    let (d1, d2, r) = (p1 - p0, q1 - q0, p0 - q0);
+    let (a, e, b, c, f) = (d1.norm2(), d2.norm2(), d1.dot(d2), d1.dot(r), d2.dot(r));
+    let denom = a * e - b * b;
+    if !(denom > T::EPSILON * a * e) {
+        return ends;
+    }
+    let s = ((b * f - c * e) / denom).max(T::ZERO).min(T::ONE);
+    let t = ((b * s + f) / e).max(T::ZERO).min(T::ONE);
+    ends.min((p0 + d1.scale(s) - q0 - d2.scale(t)).norm())
+}
+
+/// The edge vectors of a closed polygon.
+fn polygon_edges<T: Real>(p: &[Vec3<T>]) -> impl Iterator<Item = Vec3<T>> + '_ {
+    let n = p.len();
+    (0..n).filter_map(move |k| Some(*p.get((k + 1) % n)? - *p.get(k)?))
+}
+
+/// A point of the facet and its unit normal (Newell's sum, robust to a repeated corner).
+fn plane_of<T: Real>(facet: &[Vec3<T>]) -> Option<(Vec3<T>, Vec3<T>)> {
+    let first = *facet.first()?;
+    let mut normal = Vec3::ZERO;
+    for (k, &v) in facet.iter().enumerate() {
+        let w = *facet.get((k + 1) % facet.len())?;
+        normal = normal + (v - first).cross(w - first);
+    }
+    let length = normal.norm();
+    (length > T::ZERO).then(|| (first, normal.scale(T::ONE / length)))
+}
+
+/// Whether the convex hull of `points` (with edge directions `edges` and face normals
+/// `normals` as candidate axes: a facet's sides and normal) and the hull of a's and b's corners
+/// are separated by a plane (touching allowed): then no segment from a to b crosses the former's
+/// interior. The axes tried are the given normals, a's and b's normals, the cross products of
+/// the given edges with the pair's candidate edges (a's, b's and those between them), and of
+/// a's and b's edges with the edges between them (the pair's hull's side faces); a separation
+/// missed keeps the polygons, which costs events or declines them, never accuracy.
+fn separated<T: Real>(
+    points: &[Vec3<T>],
+    edges: impl Iterator<Item = Vec3<T>>,
+    normals: impl Iterator<Item = Vec3<T>>,
+    a: &[Vec3<T>; 4],
+    b: &[Vec3<T>; 4],
+    tolerance: T,
+) -> bool {
+    let hull = || a.iter().chain(b.iter()).copied();
+    let apart = |axis: Vec3<T>| {
+        let length = axis.norm();
+        if !(length > T::ZERO) {
+            return false;
+        }
+        let range = |points: &mut dyn Iterator<Item = Vec3<T>>| {
+            points.fold((T::MAX, -T::MAX), |(lo, hi), x| {
+                let d = axis.dot(x);
+                (lo.min(d), hi.max(d))
+            })
+        };
+        let (f0, f1) = range(&mut points.iter().copied());
+        let (h0, h1) = range(&mut hull());
+        let slack = tolerance * length;
+        f1 <= h0 + slack || h1 <= f0 + slack
+    };
+    let normal = |p: &[Vec3<T>]| plane_of(p).map_or(Vec3::ZERO, |(_, n)| n);
+    let mut normals = normals;
+    if apart(normal(a)) || apart(normal(b)) || normals.any(apart) {
+        return true;
+    }
+    let links = || a.iter().flat_map(|&x| b.iter().map(move |&y| y - x));
+    let hull_edges = || polygon_edges(a).chain(polygon_edges(b)).chain(links());
+    let mut edges = edges;
+    if edges.any(|e| hull_edges().any(|h| apart(e.cross(h)))) {
+        return true;
+    }
+    polygon_edges(a).chain(polygon_edges(b)).any(|e| links().any(|l| apart(e.cross(l))))
+}
+
+/// [`separated`] for one convex polygon.
+fn facet_separated<T: Real>(facet: &[Vec3<T>], a: &[Vec3<T>; 4], b: &[Vec3<T>; 4], tolerance: T) -> bool {
+    let normal = plane_of(facet).map_or(Vec3::ZERO, |(_, n)| n);
+    separated(facet, polygon_edges(facet), core::iter::once(normal), a, b, tolerance)
+}
+
+impl<T: Real> PolygonEvents<T> {
+    /// The events of outer a (affine map `outer` over `outer_rect`) against the parallelogram b
+    /// (affine map `inner` over `rect`, inside `bounds`) across `occluders` (module docs);
+    /// `None` where an occluder that may cut is not a flat convex polygon, the polygons are not
+    /// one convex polygon or one convex solid's facets, b straddles a's plane, or the lines
+    /// overflow [`MAX_POLYGON_EVENT_CURVES`]. The lines are kinks between analytic sides, and the
+    /// outer rule takes them as plain breaks, except where a comes very near b (`near`: a cut
+    /// into cells graded towards b): there the lines run into the contact, where J is singular,
+    /// and the rule is graded towards them (perpendicular squares sharing an edge, a screen on
+    /// it: 3e-8 at order 10 graded, 8e-6 not). `clear_of` (c₀, c₁, d): `None` also where a
+    /// facet of the solid comes closer than d to the segment [c₀, c₁].
+    pub(super) fn polygons<O: Occluder<T> + ?Sized>(
+        (outer, outer_rect): MappedRect<T>,
+        (inner, rect): MappedRect<T>,
+        occluders: &O,
+        bounds: &Ball<T>,
+        near: bool,
+        clear_of: Option<(Vec3<T>, Vec3<T>, T)>,
+    ) -> Option<Self> {
+        let (bo, bt, bs) = inner;
+        let at = |(o, et, es): (Vec3<T>, Vec3<T>, Vec3<T>), r: ParamRect<T>| {
+            let c = |t: T, s: T| o + et.scale(t) + es.scale(s);
+            [c(r.t0, r.s0), c(r.t1, r.s0), c(r.t1, r.s1), c(r.t0, r.s1)]
+        };
+        let (ac, bc) = (at(outer, outer_rect), at(inner, rect));
+        if straddles(outer, &bc) {
+            return None;
+        }
+        let centre = ac.iter().fold(Vec3::ZERO, |m, &c| m + c).scale(T::ONE / T::from_f64(4.0));
+        let radius = ac.iter().fold(T::ZERO, |m, &c| m.max((c - centre).norm()));
+        let from = Ball { center: centre, radius };
+        let size = ac.iter().chain(bc.iter()).fold(T::ZERO, |m, &c| m.max((c - centre).norm()));
+        let tolerance = size * T::GEOMETRY_TOLERANCE;
+        // Every polygon that may cut, and whether a segment from a to b can cross it.
+        let mut casters = [([Vec3::ZERO; FACET_CORNERS], 0usize, false); MAX_CASTERS];
+        let mut n_casters = 0usize;
+        let mut fits = true;
+        let supported = occluders.shadow_casters(&from, &bc, bounds, &mut |caster| match caster {
+            Caster::Polygon(corners) => match (casters.get_mut(n_casters), corners.len() <= FACET_CORNERS) {
+                (Some(slot), true) => {
+                    for (x, &c) in slot.0.iter_mut().zip(corners) {
+                        *x = c;
+                    }
+                    *slot = (slot.0, corners.len(), !facet_separated(corners, &ac, &bc, tolerance));
+                    n_casters += 1;
+                }
+                _ => fits = false,
+            },
+            Caster::Sphere(_) => fits = false,
+        });
+        if !supported || !fits {
+            return None;
+        }
+        let casters = casters.get(..n_casters).unwrap_or_default();
+        let solid = Solid::of_cutting_component(casters)?;
+        if solid.n_facets > 1 && !solid.convex(&ac, &bc, tolerance) {
+            return None;
+        }
+        if let Some((c0, c1, clearance)) = clear_of {
+            if solid.facets().any(|facet| !(segment_to_polygon(c0, c1, facet) >= clearance)) {
+                return None;
+            }
+        }
+        let mut events = Self::empty(near, Some(outer_rect));
+        let mut room = true;
+        let nb = bt.cross(bs);
+        let unit_b = nb.scale(T::ONE / nb.norm());
+        // Above b's plane by more than rounding: a vertex there has a shadow that moves with p.
+        let above_b = |x: Vec3<T>| unit_b.dot(x - bo) > tolerance;
+        // The plane through x spanned by u and w, guarded to their double wedge; none where
+        // they are parallel to rounding (a vertex on b's edge line, an edge through b's corner).
+        let mut wedge_plane = |events: &mut Self, x: Vec3<T>, u: Vec3<T>, w: Vec3<T>| {
+            let n = u.cross(w);
+            if n.norm() > T::GEOMETRY_TOLERANCE * u.norm() * w.norm() {
+                room &= events.push_line(outer, outer_rect, Quadric::plane(x, n).guarded(n.cross(u), w.cross(n)));
+            }
+        };
+        for &v in solid.vertices().iter().filter(|&&v| above_b(v)) {
+            for k in 0..4 {
+                let (Some(&c), Some(&d)) = (bc.get(k), bc.get((k + 1) % 4)) else { return None };
+                wedge_plane(&mut events, v, c - v, d - v);
+            }
+        }
+        for &(v, w, _) in solid.edges().iter().filter(|e| above_b(e.0) || above_b(e.1)) {
+            for &c in &bc {
+                wedge_plane(&mut events, c, v - c, w - c);
+            }
+        }
+        let mut planes = true;
+        for facet in solid.facets() {
+            let (origin, normal) = plane_of(facet)?;
+            planes &= events.push_line(outer, outer_rect, Quadric::plane(origin, normal));
+        }
+        planes &= events.push_line(outer, outer_rect, Quadric::plane(bo, unit_b));
+        (room && planes).then_some(events)
+    }
+
+    /// Keeps the plane `quadric` (guarded or not) as a line in a's parameters; `false` on
+    /// overflow. A plane that a lies in or is parallel to, or whose guarded part misses a
+    /// widened by half its size on each side, is left out.
+    fn push_line(&mut self, outer: (Vec3<T>, Vec3<T>, Vec3<T>), r: ParamRect<T>, quadric: Quadric<T>) -> bool {
+        let (_, et, es) = outer;
+        let normal = quadric.g;
+        let (dt, ds) = ((r.t1 - r.t0).abs(), (r.s1 - r.s0).abs());
+        let across = (normal.dot(et) * dt).abs() + (normal.dot(es) * ds).abs();
+        let reach = normal.norm() * (et.norm() * dt + es.norm() * ds);
+        if !(across > reach * T::GEOMETRY_TOLERANCE) {
+            return true;
+        }
+        let before = self.len();
+        if !self.push_quadric(outer, quadric) {
+            return false;
+        }
+        let widened = ParamRect {
+            t0: r.t0.min(r.t1) - dt * T::HALF,
+            t1: r.t0.max(r.t1) + dt * T::HALF,
+            s0: r.s0.min(r.s1) - ds * T::HALF,
+            s1: r.s0.max(r.s1) + ds * T::HALF,
+        };
+        self.keep_if_meets(before, widened);
+        true
+    }
+}
+
+/// Whether b (its corners) has corners on both sides of a's plane beyond rounding: the visible
+/// part of b then has an edge and corners that are not b's.
+pub(super) fn straddles<T: Real>(outer: (Vec3<T>, Vec3<T>, Vec3<T>), corners: &[Vec3<T>; 4]) -> bool {
+    let (o, et, es) = outer;
+    let na = et.cross(es);
+    let size = corners.iter().fold(T::ZERO, |m, &c| m.max((c - corners[0]).norm())).max(et.norm()).max(es.norm());
+    let band = na.norm() * size * T::GEOMETRY_TOLERANCE;
+    let (front, behind) = corners.iter().fold((false, false), |(f, b), &c| {
+        let h = na.dot(c - o);
+        (f || h > band, b || h < -band)
+    });
+    front && behind
+}
