@@ -324,7 +324,7 @@ where
 
 /// A touching flat pair across flat occluders ([`Route::ContactPastShadows`]): the unoccluded
 /// exchange U in the tolerance mode at half the tolerance, less the blocked part B
-/// ([`crate::boundary::blocked_unchecked`]) at orders 4, 6, … until its estimate (as
+/// ([`crate::boundary::Blocked`]) at orders 4, 6, … until its estimate (as
 /// [`by_order_doubling`]'s, three orders at least) is within the other half of the tolerance
 /// on U − B; the estimate is the sum of both. `None` where B does not apply or does not meet
 /// its half by `max_order` (the caller then takes the pair by its other route, which splits).
@@ -343,7 +343,8 @@ where
     O: Occluder<T> + ?Sized,
 {
     let half = settings.tolerance * T::HALF;
-    let blocked = |order: usize| crate::boundary::blocked_unchecked(a, b, order, occluders);
+    let Some(part) = crate::boundary::Blocked::new(a, b, occluders)? else { return Ok(None) };
+    let blocked = |order: usize| part.sum(order);
     let first = 4usize.min(settings.max_order);
     let Some((mut previous, mut evaluations)) = blocked(first)? else { return Ok(None) };
     let unoccluded = recurse::<T, SA, SB, (), CAP>(a, b, Adaptive { tolerance: half, ..settings }, &(), 0)?;

@@ -20,68 +20,82 @@
 
 use super::*;
 
-/// B for the pair (a, b) at `order` (module docs): (A_a·F_blocked, evaluations), finite but not
-/// bounds-checked; `None` where a or b is not a parallelogram, the occluders give no polygon
-/// events, or some outer point's J_blocked is not in closed form.
-pub(crate) fn blocked_unchecked<T, SA, SB, O>(
-    a: &Patch<'_, T, SA>,
-    b: &Patch<'_, T, SB>,
-    order: usize,
-    occluders: &O,
-) -> Result<Option<(T, u64)>, PdmError>
+/// The blocked part B of a touching flat pair (module docs), set up once for any order: the
+/// pair, b's map and ball, and the occluders' outer events, which do not depend on the order.
+pub(crate) struct Blocked<'x, T: Real, SA: ?Sized, SB: ?Sized, O: ?Sized> {
+    a: &'x Patch<'x, T, SA>,
+    b: &'x Patch<'x, T, SB>,
+    map: (Vec3<T>, Vec3<T>, Vec3<T>),
+    bounds: Ball<T>,
+    events: PolygonEvents<T>,
+    occluders: &'x O,
+}
+
+impl<'x, T, SA, SB, O> Blocked<'x, T, SA, SB, O>
 where
     T: Real,
     SA: Surface<T> + ?Sized,
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
-    let (outer, surface, r) = (a.surface(), b.surface(), b.rect());
-    let (Some(outer_map), Some(map)) = (outer.affine_map(), surface.affine_map()) else { return Ok(None) };
-    let bounds = part_ball(surface, Some(map), r)?;
-    let Some(contact) = contact(outer_map, a.rect(), map, r) else { return Ok(None) };
-    let Some(events) =
-        PolygonEvents::polygons((outer_map, a.rect()), (map, r), occluders, &bounds, false, Some(contact))
-    else {
-        return Ok(None);
-    };
-    let count = core::cell::Cell::new(0u64);
-    let inner = Inner {
-        surface,
-        r,
-        rule: GaussRule::<T>::new(order)?,
-        probes: 2 * order + 3,
-        affine: None,
-        parallelogram: Some(map),
-        trigonometric: false,
-        outline: None,
-        line_rule: GaussRule::<T>::new(order.max(16))?,
-        use_occluders: true,
-        occluders,
-        count: &count,
-        scratch: core::cell::RefCell::new(LineScratch::new()),
-        signature_line: core::cell::RefCell::new(Line::new()),
-    };
-    let mut closed = true;
-    let mut f = |t: T, s: T| -> Result<T, PdmError> {
-        let (p, n) = outer.point_and_normal(t, s);
-        let area = n.norm();
-        if !(area > T::ZERO) {
-            return Ok(T::ZERO);
-        }
-        inner.tick();
-        match point_blocked(&inner, &bounds, p, n.scale(T::ONE / area)) {
-            Some(j) => Ok(area * j),
-            None => {
-                closed = false;
-                Ok(T::ZERO)
-            }
-        }
-    };
-    let total = events.integrate(a.rect(), &inner.rule, &mut f)?;
-    if !closed {
-        return Ok(None);
+    /// `None` where a or b is not a parallelogram, they share no corner, or the occluders give
+    /// no polygon events clear of the contact ([`CLEARANCE`]).
+    pub(crate) fn new(
+        a: &'x Patch<'x, T, SA>,
+        b: &'x Patch<'x, T, SB>,
+        occluders: &'x O,
+    ) -> Result<Option<Self>, PdmError> {
+        let (surface, r) = (b.surface(), b.rect());
+        let (Some(outer_map), Some(map)) = (a.surface().affine_map(), surface.affine_map()) else { return Ok(None) };
+        let bounds = part_ball(surface, Some(map), r)?;
+        let Some(contact) = contact(outer_map, a.rect(), map, r) else { return Ok(None) };
+        let events = PolygonEvents::polygons((outer_map, a.rect()), (map, r), occluders, &bounds, false, Some(contact));
+        Ok(events.map(|events| Self { a, b, map, bounds, events, occluders }))
     }
-    Ok(Some((crate::bounds::finite(total * T::FRAC_1_PI)?, count.get())))
+
+    /// B at `order`: (A_a·F_blocked, evaluations), finite but not bounds-checked; `None` where
+    /// some outer point's J_blocked is not in closed form.
+    pub(crate) fn sum(&self, order: usize) -> Result<Option<(T, u64)>, PdmError> {
+        let (outer, surface, r) = (self.a.surface(), self.b.surface(), self.b.rect());
+        let count = core::cell::Cell::new(0u64);
+        let inner = Inner {
+            surface,
+            r,
+            rule: GaussRule::<T>::new(order)?,
+            probes: 2 * order + 3,
+            affine: None,
+            parallelogram: Some(self.map),
+            trigonometric: false,
+            outline: None,
+            line_rule: GaussRule::<T>::new(order.max(16))?,
+            use_occluders: true,
+            occluders: self.occluders,
+            count: &count,
+            scratch: core::cell::RefCell::new(LineScratch::new()),
+            signature_line: core::cell::RefCell::new(Line::new()),
+        };
+        let mut closed = true;
+        let mut f = |t: T, s: T| -> Result<T, PdmError> {
+            let (p, n) = outer.point_and_normal(t, s);
+            let area = n.norm();
+            if !(area > T::ZERO) {
+                return Ok(T::ZERO);
+            }
+            inner.tick();
+            match point_blocked(&inner, &self.bounds, p, n.scale(T::ONE / area)) {
+                Some(j) => Ok(area * j),
+                None => {
+                    closed = false;
+                    Ok(T::ZERO)
+                }
+            }
+        };
+        let total = self.events.integrate(self.a.rect(), &inner.rule, &mut f)?;
+        if !closed {
+            return Ok(None);
+        }
+        Ok(Some((crate::bounds::finite(total * T::FRAC_1_PI)?, count.get())))
+    }
 }
 
 /// How far from the contact, in the larger patch's diagonals, the occluders must keep
@@ -100,11 +114,7 @@ fn contact<T: Real>(
     b: (Vec3<T>, Vec3<T>, Vec3<T>),
     rb: ParamRect<T>,
 ) -> Option<(Vec3<T>, Vec3<T>, T)> {
-    let corners = |(o, et, es): (Vec3<T>, Vec3<T>, Vec3<T>), r: ParamRect<T>| {
-        let c = |t: T, s: T| o + et.scale(t) + es.scale(s);
-        [c(r.t0, r.s0), c(r.t1, r.s0), c(r.t1, r.s1), c(r.t0, r.s1)]
-    };
-    let (ac, bc) = (corners(a, ra), corners(b, rb));
+    let (ac, bc) = (map_corners(a, ra), map_corners(b, rb));
     let diagonal = |c: &[Vec3<T>; 4]| (c[2] - c[0]).norm().max((c[3] - c[1]).norm());
     let size = diagonal(&ac).max(diagonal(&bc));
     let tolerance = size * T::GEOMETRY_TOLERANCE;

@@ -154,18 +154,8 @@ impl<T: Real, const N: usize, const SB: usize, const TB: usize> Events<T, N, SB,
         let (bo, bt, bs) = inner;
         let mut events = Self::empty(true, None);
         let mut overflow = false;
-        let corner = |t: T, s: T| bo + bt.scale(t) + bs.scale(s);
-        let corners =
-            [corner(rect.t0, rect.s0), corner(rect.t1, rect.s0), corner(rect.t1, rect.s1), corner(rect.t0, rect.s1)];
-        // b straddling a's plane: the visible part of b is clipped by it.
-        let na = et.cross(es);
-        let size = corners.iter().fold(T::ZERO, |m, &c| m.max((c - bo).norm())).max(et.norm()).max(es.norm());
-        let band = na.norm() * size * T::GEOMETRY_TOLERANCE;
-        let (front, behind) = corners.iter().fold((false, false), |(f, b), &c| {
-            let h = na.dot(c - o);
-            (f || h > band, b || h < -band)
-        });
-        if front && behind {
+        let corners = map_corners(inner, rect);
+        if straddles(outer, bo, &corners) {
             return None;
         }
         for k in 0..4 {

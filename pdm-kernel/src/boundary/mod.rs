@@ -124,7 +124,7 @@ mod polygon_events;
 #[cfg(feature = "closed-form")]
 mod shadows;
 #[cfg(feature = "closed-form")]
-pub(crate) use blocked::blocked_unchecked;
+pub(crate) use blocked::Blocked;
 use breaks::*;
 #[cfg(feature = "closed-form")]
 use events::*;
@@ -322,7 +322,15 @@ where
     Ok(Some(total))
 }
 
+/// The corners of the parallelogram with affine map (o, e_t, e_s) over `r`, in order around it.
+#[cfg(feature = "closed-form")]
+fn map_corners<T: Real>((o, et, es): (Vec3<T>, Vec3<T>, Vec3<T>), r: ParamRect<T>) -> [Vec3<T>; 4] {
+    let at = |t: T, s: T| o + et.scale(t) + es.scale(s);
+    [at(r.t0, r.s0), at(r.t1, r.s0), at(r.t1, r.s1), at(r.t0, r.s1)]
+}
+
 /// J(p) times a's area element at a's parameters (t, s).
+#[cfg(feature = "closed-form")]
 fn outer_integrand<T, SA, SB, O, const CB: usize>(
     surface: &SA,
     t: T,

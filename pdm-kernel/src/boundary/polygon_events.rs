@@ -364,12 +364,8 @@ impl<T: Real> PolygonEvents<T> {
         clear_of: Option<(Vec3<T>, Vec3<T>, T)>,
     ) -> Option<Self> {
         let (bo, bt, bs) = inner;
-        let at = |(o, et, es): (Vec3<T>, Vec3<T>, Vec3<T>), r: ParamRect<T>| {
-            let c = |t: T, s: T| o + et.scale(t) + es.scale(s);
-            [c(r.t0, r.s0), c(r.t1, r.s0), c(r.t1, r.s1), c(r.t0, r.s1)]
-        };
-        let (ac, bc) = (at(outer, outer_rect), at(inner, rect));
-        if straddles(outer, &bc) {
+        let (ac, bc) = (map_corners(outer, outer_rect), map_corners(inner, rect));
+        if straddles(outer, bo, &bc) {
             return None;
         }
         let centre = ac.iter().fold(Vec3::ZERO, |m, &c| m + c).scale(T::ONE / T::from_f64(4.0));
@@ -468,12 +464,12 @@ impl<T: Real> PolygonEvents<T> {
     }
 }
 
-/// Whether b (its corners) has corners on both sides of a's plane beyond rounding: the visible
-/// part of b then has an edge and corners that are not b's.
-pub(super) fn straddles<T: Real>(outer: (Vec3<T>, Vec3<T>, Vec3<T>), corners: &[Vec3<T>; 4]) -> bool {
+/// Whether b (its `corners`; `origin` a point of its plane) has corners on both sides of a's
+/// plane beyond rounding: the visible part of b then has an edge and corners that are not b's.
+pub(super) fn straddles<T: Real>(outer: (Vec3<T>, Vec3<T>, Vec3<T>), origin: Vec3<T>, corners: &[Vec3<T>; 4]) -> bool {
     let (o, et, es) = outer;
     let na = et.cross(es);
-    let size = corners.iter().fold(T::ZERO, |m, &c| m.max((c - corners[0]).norm())).max(et.norm()).max(es.norm());
+    let size = corners.iter().fold(T::ZERO, |m, &c| m.max((c - origin).norm())).max(et.norm()).max(es.norm());
     let band = na.norm() * size * T::GEOMETRY_TOLERANCE;
     let (front, behind) = corners.iter().fold((false, false), |(f, b), &c| {
         let h = na.dot(c - o);

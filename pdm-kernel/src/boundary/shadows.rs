@@ -97,10 +97,7 @@ impl<T: Real> Piece<T> {
 impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB, O> {
     /// b's corners where b is a parallelogram.
     fn corners(&self) -> Option<[Vec3<T>; 4]> {
-        let (o, et, es) = self.parallelogram?;
-        let r = self.r;
-        let at = |t: T, s: T| o + et.scale(t) + es.scale(s);
-        Some([at(r.t0, r.s0), at(r.t1, r.s0), at(r.t1, r.s1), at(r.t0, r.s1)])
+        Some(map_corners(self.parallelogram?, self.r))
     }
 
     /// Whether b is a parallelogram and every occluder that may cut a segment from p to it is

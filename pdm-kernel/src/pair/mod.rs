@@ -333,7 +333,7 @@ where
 
 /// A touching flat pair across flat occluders ([`Route::ContactPastShadows`]) at `order`: the
 /// unoccluded exchange by the contour form less the part the occluders block
-/// ([`crate::boundary::blocked_unchecked`]), as `dispatch` returns it (the contour form's
+/// ([`crate::boundary::Blocked`]), as `dispatch` returns it (the contour form's
 /// rounding bound with it); `None` where either part does not apply.
 #[cfg(feature = "closed-form")]
 #[inline(never)]
@@ -353,9 +353,8 @@ where
     if crate::bounds::cancels(unoccluded, rounding) {
         return Ok(None);
     }
-    let Some((blocked, blocked_count)) = crate::boundary::blocked_unchecked(a, b, order, occluders)? else {
-        return Ok(None);
-    };
+    let Some(part) = crate::boundary::Blocked::new(a, b, occluders)? else { return Ok(None) };
+    let Some((blocked, blocked_count)) = part.sum(order)? else { return Ok(None) };
     Ok(Some((unoccluded - blocked, count.saturating_add(blocked_count), rounding)))
 }
 
