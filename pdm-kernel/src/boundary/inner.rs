@@ -725,10 +725,15 @@ pub(super) fn polygon_past_sphere<T: Real>(
 ) -> Option<(T, T)> {
     // Positive orientation about the directions from p (P's normal by the right-hand rule
     // pointing away from p), which the cone's circle shares with increasing ψ below.
+    // The orientation from the whole outline (its area vector), not from three corners,
+    // which may lie on one line (a piece of b clipped through a corner repeats it).
     let n = poly.len();
     let first = poly.first().copied().unwrap_or(Vec3::ZERO);
-    let (second, third) = (poly.get(1).copied().unwrap_or(first), poly.get(2).copied().unwrap_or(first));
-    if (second - first).cross(third - first).dot(first - p) < T::ZERO {
+    let area = poly
+        .iter()
+        .zip(poly.iter().cycle().skip(1))
+        .fold(Vec3::ZERO, |sum, (&v, &w)| sum + (v - first).cross(w - first));
+    if area.dot(first - p) < T::ZERO {
         poly.reverse();
     }
     let used: &[Vec3<T>] = poly;

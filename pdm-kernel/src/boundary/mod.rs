@@ -908,6 +908,50 @@ mod tests {
         })
     }
 
+    /// A slab seen edge-on (p at the height of a table top 0.04 thick, near the plane of its
+    /// end) and a sphere off to one side whose cone meets none of the slab's shadows: b less
+    /// the slab's shadows is cut into slivers, and each sliver less the sphere's cone must keep
+    /// its orientation and its corners once. The reference is inclusion–exclusion with the
+    /// methods checked on their own (the slab alone against the lines, the sphere alone
+    /// against the lines, b unshadowed): J = J_slab + J_sphere − J_b. The lines with both
+    /// occluders are no reference here: they move by 1e-4 of J from point to point.
+    #[test]
+    fn slivers_past_a_slab_and_a_sphere_match_inclusion_exclusion() {
+        use crate::visibility::AnyOccluder;
+        let q = |o: [f64; 3], t: [f64; 3], s: [f64; 3]| {
+            AnyOccluder::Parallelogram(
+                Parallelogram::new(vec3(o[0], o[1], o[2]), vec3(t[0], t[1], t[2]), vec3(s[0], s[1], s[2])).unwrap(),
+            )
+        };
+        let (z0, z1) = (0.72, 0.76);
+        let lamp = Sphere::outer(vec3(2.0, 3.5, 2.1), 0.15).unwrap();
+        let slab = [
+            q([1.0, 1.5, z0], [0.0, 0.9, 0.0], [1.4, 0.0, 0.0]),
+            q([1.0, 1.5, z1], [1.4, 0.0, 0.0], [0.0, 0.9, 0.0]),
+            q([1.0, 1.5, z0], [1.4, 0.0, 0.0], [0.0, 0.0, z1 - z0]),
+            q([1.0, 2.4, z0], [0.0, 0.0, z1 - z0], [1.4, 0.0, 0.0]),
+            q([1.0, 1.5, z0], [0.0, 0.0, z1 - z0], [0.0, 0.9, 0.0]),
+            q([2.4, 1.5, z0], [0.0, 0.9, 0.0], [0.0, 0.0, z1 - z0]),
+        ];
+        let mut both = [AnyOccluder::Sphere(lamp); 7];
+        both[..6].copy_from_slice(&slab);
+        let wall = Parallelogram::new(vec3(0.0, 5.0, 2.5), vec3(0.0, 0.0, -2.5), vec3(4.0, 0.0, 0.0)).unwrap();
+        let np = vec3(0.0, 1.0, 0.0);
+        let mut worst = 0.0f64;
+        for k in 0..24 {
+            for m in 0..24 {
+                let p = vec3(2.3 + 0.1 * (k as f64 + 0.5) / 24.0, 0.0, 0.70 + 0.08 * (m as f64 + 0.5) / 24.0);
+                let (closed, _, reach) = past_polygons(&wall, &both.as_slice(), p, np).expect("closed form answers");
+                let (slab_only, slab_lines, _) = past_polygons(&wall, &slab.as_slice(), p, np).unwrap();
+                let (sphere_only, sphere_lines, unshadowed) = past_sphere(&wall, &lamp, p, np).unwrap();
+                assert!((slab_only - slab_lines).abs() < 1e-11 * reach, "{p:?}: slab alone off the lines");
+                assert!((sphere_only - sphere_lines).abs() < 1e-11 * reach, "{p:?}: sphere alone off the lines");
+                worst = worst.max((closed - (slab_only + sphere_only - unshadowed)).abs() / reach);
+            }
+        }
+        assert!(worst < 1e-12, "{worst:e} of the solid angle off");
+    }
+
     /// b less the shadows of flat convex occluders ([`Inner::point_past_polygons`]) against
     /// the lines with the occluders' polynomials ([`Inner::refined`] at order 20, a different
     /// method), from random points above random parallelograms: up to three random

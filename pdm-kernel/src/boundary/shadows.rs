@@ -203,11 +203,23 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
                 let at = |(t, s): (T, T)| o + et.scale(t) + es.scale(s);
                 let verts = piece.vertices();
                 if let Some(ball) = sphere {
+                    // The piece's corners, each once (a cut through a corner repeats it).
                     let mut poly = [Vec3::ZERO; PIECE_VERTICES];
-                    for (slot, &v) in poly.iter_mut().zip(verts) {
-                        *slot = at(v);
+                    let mut m = 0usize;
+                    for &v in verts {
+                        let x = at(v);
+                        if m == 0 || poly.get(m - 1) != Some(&x) {
+                            *poly.get_mut(m)? = x;
+                            m += 1;
+                        }
                     }
-                    let (visible, size) = polygon_past_sphere(p, np, poly.get_mut(..verts.len())?, &ball)?;
+                    if m > 1 && poly.first() == poly.get(m - 1) {
+                        m -= 1;
+                    }
+                    if m < 3 {
+                        continue;
+                    }
+                    let (visible, size) = polygon_past_sphere(p, np, poly.get_mut(..m)?, &ball)?;
                     sum += visible;
                     magnitude += size;
                     continue;
