@@ -175,9 +175,9 @@ where
     // order, like a smooth pair: orders 4, 6, … compared as such, the larger patch halved at
     // `max_order`.
     #[cfg(feature = "closed-form")]
-    if crate::boundary::outer_events_apply(a, b, occluders) {
+    if let Some(outer_b) = crate::pair::events_outer(a, b, occluders, false) {
         let eval = |order: usize| {
-            crate::pair::PairContext::<T, SA, SB, O, CAP>::new(a, b, occluders).boundary(order, false, 1, occluders)
+            crate::pair::PairContext::<T, SA, SB, O, CAP>::new(a, b, occluders).boundary(order, outer_b, 1, occluders)
         };
         return by_order_doubling::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, eval, 4, Split::LargerChecked);
     }

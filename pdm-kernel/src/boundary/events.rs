@@ -128,6 +128,9 @@ pub(super) struct Events<T, const N: usize, const SB: usize, const TB: usize> {
     /// the patch J need not continue J inside it (an occluder standing on the patch's edge
     /// hides everything from beyond it).
     limit: Option<ParamRect<T>>,
+    /// The sides of `limit` (t₀, t₁, s₀, s₁) towards which the rule is graded: an occluder
+    /// touches the outer patch there, and J is singular along that side.
+    graded_sides: [bool; 4],
 }
 
 /// The events of an occluder that gives its quadrics (a sphere), or of a curved inner patch.
@@ -136,7 +139,37 @@ pub(super) type QuadricEvents<T> = Events<T, MAX_EVENT_CURVES, MAX_S_BREAKS, MAX
 impl<T: Real, const N: usize, const SB: usize, const TB: usize> Events<T, N, SB, TB> {
     /// No curves yet.
     pub(super) fn empty(grade: bool, limit: Option<ParamRect<T>>) -> Self {
-        Self { curves: [Curve { conic: [T::ZERO; 6], guard: None, grade }; N], n: 0, grade, limit }
+        Self {
+            curves: [Curve { conic: [T::ZERO; 6], guard: None, grade }; N],
+            n: 0,
+            grade,
+            limit,
+            graded_sides: [false; 4],
+        }
+    }
+
+    /// Grades the rule towards side `k` (t₀, t₁, s₀, s₁) of the limit rectangle.
+    pub(super) fn grade_side(&mut self, k: usize) {
+        if let Some(side) = self.graded_sides.get_mut(k) {
+            *side = true;
+        }
+    }
+
+    /// Whether an occluder touches a side of the outer patch ([`Self::grade_side`]): J is then
+    /// singular there, and the rule converges only algebraically with the order.
+    pub(super) fn touches_side(&self) -> bool {
+        self.graded_sides.iter().any(|&g| g)
+    }
+
+    /// Whether the rule is graded at `x` on the side `k` of the limit rectangle.
+    fn side_graded(&self, k: usize, x: T) -> bool {
+        let at = |l: ParamRect<T>| match k {
+            0 => l.t0,
+            1 => l.t1,
+            2 => l.s0,
+            _ => l.s1,
+        };
+        self.graded_sides.get(k).copied().unwrap_or(false) && self.limit.is_some_and(|l| at(l) == x)
     }
 
     /// The events of outer a (affine map `outer`: p = o + t·e_t + s·e_s) against inner b (affine
@@ -250,6 +283,11 @@ impl<T: Real, const N: usize, const SB: usize, const TB: usize> Events<T, N, SB,
         }
     }
 
+    /// Whether the curves pushed from now on are graded ([`Curve`]).
+    pub(super) fn set_grade(&mut self, grade: bool) {
+        self.grade = grade;
+    }
+
     /// How many curves are kept.
     pub(super) fn len(&self) -> usize {
         self.n
@@ -265,8 +303,9 @@ impl<T: Real, const N: usize, const SB: usize, const TB: usize> Events<T, N, SB,
     ) -> Result<T, PdmError> {
         let mut breaks = [(T::ZERO, false); SB];
         let mut n = 0usize;
+        let (grade_s0, grade_s1) = (self.side_graded(2, r.s0), self.side_graded(3, r.s1));
         let mut place = |x: T, grade: bool| place_near(x, grade, r.s0, r.s1, &mut breaks, &mut n);
-        place(r.s0, false);
+        place(r.s0, grade_s0);
         for curve in self.used() {
             let mut add = |x: T| place(x, curve.grade);
             let [tt, ts, ss, t1, s1, c] = curve.conic;
@@ -324,7 +363,7 @@ impl<T: Real, const N: usize, const SB: usize, const TB: usize> Events<T, N, SB,
                 }
             }
         }
-        place(r.s1, false);
+        place(r.s1, grade_s1);
         let (lo, hi) = self.limit.map_or((-T::MAX, T::MAX), |l| (l.s0, l.s1));
         graded_sum(breaks.get_mut(..n).unwrap_or_default(), r.s0, r.s1, (lo, hi), rule, &mut |s| {
             self.line(r, s, rule, f)
@@ -341,8 +380,9 @@ impl<T: Real, const N: usize, const SB: usize, const TB: usize> Events<T, N, SB,
     ) -> Result<T, PdmError> {
         let mut breaks = [(T::ZERO, false); TB];
         let mut n = 0usize;
+        let (grade_t0, grade_t1) = (self.side_graded(0, r.t0), self.side_graded(1, r.t1));
         let mut place = |x: T, grade: bool| place_near(x, grade, r.t0, r.t1, &mut breaks, &mut n);
-        place(r.t0, false);
+        place(r.t0, grade_t0);
         for curve in self.used() {
             let [tt, ts, ss, t1, s1, c] = curve.conic;
             roots_near_double(tt, ts * s + t1, (ss * s + s1) * s + c, &mut |t| {
@@ -351,7 +391,7 @@ impl<T: Real, const N: usize, const SB: usize, const TB: usize> Events<T, N, SB,
                 }
             });
         }
-        place(r.t1, false);
+        place(r.t1, grade_t1);
         let (lo, hi) = self.limit.map_or((-T::MAX, T::MAX), |l| (l.t0, l.t1));
         graded_sum(breaks.get_mut(..n).unwrap_or_default(), r.t0, r.t1, (lo, hi), rule, &mut |t| f(t, s))
     }

@@ -463,35 +463,57 @@ where
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
+    outer_events_state(outer, inner, occluders) == Some(true)
+}
+
+/// The outer events with `outer` outside: `None` where none are placed, `Some(exponential)`
+/// where they are: `Some(false)` where an occluder touches the outer patch ([`PolygonEvents`]:
+/// a cabinet's foot on a floor facet's edge), so that its integral converges only
+/// algebraically ([`outer_events_apply`] is then `false`).
+#[cfg(feature = "closed-form")]
+pub(crate) fn outer_events_state<T, SA, SB, O>(
+    outer: &Patch<'_, T, SA>,
+    inner: &Patch<'_, T, SB>,
+    occluders: &O,
+) -> Option<bool>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
     let (surface, r) = (inner.surface(), inner.rect());
     let affine = surface.affine_map();
-    let Ok(bounds) = part_ball(surface, affine, r) else { return false };
+    let bounds = part_ball(surface, affine, r).ok()?;
     let use_occluders = occluders.may_block_between(&outer.enclosing_ball(), &bounds);
     match outer.surface().affine_map() {
         Some(outer_map) => {
-            pair_events(outer_map, surface, r, affine, use_occluders, occluders, &bounds).is_some()
-                || (use_occluders
-                    && affine.is_some_and(|inner_map| {
-                        polygon_events_apply(outer_map, outer.rect(), inner_map, r, occluders, &bounds)
-                    }))
+            if pair_events(outer_map, surface, r, affine, use_occluders, occluders, &bounds).is_some() {
+                return Some(true);
+            }
+            let inner_map = affine.filter(|_| use_occluders)?;
+            polygon_events_state(outer_map, outer.rect(), inner_map, r, occluders, &bounds)
         }
-        None => curved_outer_events(outer.surface(), affine, r, use_occluders).is_some(),
+        None => curved_outer_events(outer.surface(), affine, r, use_occluders).map(|_| true),
     }
 }
 
-/// Whether a flat pair's events across flat convex occluders are placed ([`PolygonEvents`]), in
-/// a frame of its own as [`polygon_events_sum`].
+/// Whether a flat pair's events across flat convex occluders are placed ([`PolygonEvents`]):
+/// `Some(true)` where they make the outer integral converge exponentially, `Some(false)` where
+/// an occluder touches the outer patch (a cabinet's corner on the floor's makes J singular
+/// there); in a frame of its own as [`polygon_events_sum`].
 #[cfg(feature = "closed-form")]
 #[inline(never)]
-fn polygon_events_apply<T: Real, O: Occluder<T> + ?Sized>(
+fn polygon_events_state<T: Real, O: Occluder<T> + ?Sized>(
     outer_map: (Vec3<T>, Vec3<T>, Vec3<T>),
     outer_rect: ParamRect<T>,
     inner_map: (Vec3<T>, Vec3<T>, Vec3<T>),
     r: ParamRect<T>,
     occluders: &O,
     bounds: &Ball<T>,
-) -> bool {
-    PolygonEvents::polygons((outer_map, outer_rect), (inner_map, r), occluders, bounds, false, None).is_some()
+) -> Option<bool> {
+    PolygonEvents::polygons((outer_map, outer_rect), (inner_map, r), occluders, bounds, false, None)
+        .map(|events| !events.touches_side())
 }
 
 /// Most cells into which [`outer_cells`] cuts the outer patch (each costs one outer rule).

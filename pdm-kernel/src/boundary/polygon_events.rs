@@ -23,15 +23,29 @@
 //! beyond p's height casts its shadow beyond every bounded b, so p passing a vertex's height
 //! is no event either.
 //!
-//! Where two separate occluders' shadows can meet on b, J also changes where a vertex of one's
-//! shadow crosses an edge of the other's (planes) and where two shadow edges cross on an edge
-//! of b (three lines meeting: quadric surfaces), dozens to hundreds of curves for two boxes, most
-//! of them inside the union of the shadows where nothing changes. Those pairs are declined
-//! (`None`): the outer rule samples across their events as before. Occluders that cannot cut
-//! any segment from a to b (a separating plane between the occluder and the hull of a and b)
-//! are left out first, so a room's walls do not count against a pair of other walls.
+//! Several convex solids (and at most one sphere, whose events are `Events::new`'s: its shadow
+//! through b's corners and tangent to b's edges) take the union of their events where their
+//! shadows can never meet on b: no segment from a to b meets two of them, which a
+//! separating-axis test proves ([`shadows_apart`]). J is then b less disjoint shadows, and its
+//! structure changes only at each one's own events. Where two shadows can meet, J also
+//! changes where a vertex of one's shadow crosses an edge of the other's (planes) and where two
+//! shadow edges cross on an edge of b (three lines meeting: quadric surfaces), dozens to
+//! hundreds of curves for two boxes, most of them inside the union of the shadows where
+//! nothing changes. Those pairs are declined (`None`): the outer rule samples across their
+//! events as before.
+//!
+//! Occluders that cannot cut any segment from a to b (a separating plane between the occluder
+//! and the hull of a and b, or lying on or behind a's or b's plane) are left out first, so a
+//! room's walls do not count against a pair of other walls, nor a box's other facets against
+//! one of its own. The polygons that can cut are grouped into solids by shared edges as long as
+//! the group stays convex ([`label_solids`]), so that a cabinet standing in a hole of the floor
+//! is one solid, not one with the floor. An occluder touching a's boundary (the cabinet's foot
+//! on a floor facet's edge) makes J singular along that side: the rule is graded towards it,
+//! and the pair is reported as not converging exponentially (`Events::touches_side`), so that
+//! the pair takes the other patch outside or the tolerance mode's estimate for such pairs.
 
 use super::*;
+use crate::surface::Sphere;
 use crate::visibility::{Caster, Quadric};
 
 /// Most event lines of one pair across polygons: a box's eight vertices against b's four
@@ -56,6 +70,14 @@ const MAX_FACETS: usize = 12;
 /// Most polygons that may cut from a's ball ([`Occluder::shadow_casters`]), of all solids: a
 /// room's walls, a table's and a cabinet's facets.
 const MAX_CASTERS: usize = 32;
+
+/// Most separate convex solids whose events one pair takes (a table and a cabinet in a room,
+/// with room for two more), besides at most one sphere.
+const MAX_SOLIDS: usize = 4;
+
+/// A polygon that may cut: its corners, their number, and whether a segment from a to b can
+/// cross it (else it only closes a solid: [`label_solids`]).
+type CasterPolygon<T> = ([Vec3<T>; FACET_CORNERS], usize, bool);
 
 /// Most corners of one facet ([`Caster::Polygon`]: a quadrilateral, a triangle as one).
 const FACET_CORNERS: usize = 6;
@@ -87,49 +109,11 @@ impl<T: Real> Solid<T> {
         }
     }
 
-    /// The facets connected (by shared edges) to the `casters` that a segment from a to b can
-    /// cross (the flag), whether those can be crossed or not: the solid whose shadow the
-    /// crossed facets' shadows make up. `Some(empty)` where none can be crossed; `None` where
-    /// those that can lie on more than one connected set, or on overflow.
-    fn of_cutting_component(casters: &[([Vec3<T>; FACET_CORNERS], usize, bool)]) -> Option<Self> {
-        let corners = |k: usize| casters.get(k).map(|(c, n, _)| c.get(..*n).unwrap_or_default()).unwrap_or_default();
-        let share_edge = |i: usize, j: usize| {
-            let (p, q) = (corners(i), corners(j));
-            let edge = |c: &[Vec3<T>], k: usize| (c.get(k).copied(), c.get((k + 1) % c.len().max(1)).copied());
-            (0..p.len()).any(|k| {
-                let (v, w) = edge(p, k);
-                v != w && (0..q.len()).any(|m| edge(q, m) == (w, v) || edge(q, m) == (v, w))
-            })
-        };
-        // Component labels by repeated relaxation (a few dozen polygons).
-        let mut label = [0usize; MAX_CASTERS];
-        for (k, l) in label.iter_mut().enumerate() {
-            *l = k;
-        }
-        let n = casters.len();
-        let mut changed = true;
-        while changed {
-            changed = false;
-            for i in 0..n {
-                for j in 0..n {
-                    let (Some(&li), Some(&lj)) = (label.get(i), label.get(j)) else { continue };
-                    if lj < li && share_edge(i, j) {
-                        if let Some(l) = label.get_mut(i) {
-                            *l = lj;
-                        }
-                        changed = true;
-                    }
-                }
-            }
-        }
-        let mut cutting = casters.iter().zip(label.iter()).filter(|((_, _, crossed), _)| *crossed).map(|(_, &l)| l);
+    /// The facets labelled `label` ([`label_solids`]).
+    fn of_label(casters: &[CasterPolygon<T>], labels: &[u8; MAX_CASTERS], label: u8) -> Option<Self> {
         let mut solid = Self::new();
-        let Some(component) = cutting.next() else { return Some(solid) };
-        if cutting.any(|l| l != component) {
-            return None;
-        }
-        for (k, _) in label.iter().take(n).enumerate().filter(|(_, &l)| l == component) {
-            solid.push(corners(k))?;
+        for ((corners, n, _), _) in casters.iter().zip(labels.iter()).filter(|(_, &l)| l == label) {
+            solid.push(corners.get(..*n).unwrap_or_default())?;
         }
         Some(solid)
     }
@@ -226,8 +210,336 @@ impl<T: Real> Solid<T> {
         let rim = rim.get(..n).unwrap_or_default();
         let edges = open().map(|&(v, w, _)| w - v);
         let normals = open().flat_map(|&(v, w, _)| rim.iter().map(move |&x| (w - v).cross(x - v)));
-        separated(rim, edges, normals, ac, bc, tolerance)
+        separated(rim, edges, normals, ac, bc, tolerance) || self.open_faces_separated(rim, ac, bc, tolerance)
     }
+
+    /// Where the uncovered part is a set of whole faces of H, each bounded by one loop of open
+    /// edges (a cabinet whose top a scene culled, standing on the floor without a bottom): each
+    /// face separated from the hull of a and b on its own ([`separated`]). A loop bounds such a
+    /// face where its vertices lie in one plane that every vertex of H lies on one side of and
+    /// no facet lies in; a loop that does not (the band of uncovered sides between a given top
+    /// and bottom, whose two loops bound one region) leaves the whole rim to the caller's test.
+    fn open_faces_separated(&self, rim: &[Vec3<T>], ac: &[Vec3<T>; 4], bc: &[Vec3<T>; 4], tolerance: T) -> bool {
+        let open = || self.edges().iter().filter(|e| e.2 == 1);
+        // Loops by relaxation over shared vertices (a few dozen edges).
+        let mut label = [0usize; MAX_VERTICES];
+        for (k, l) in label.iter_mut().enumerate() {
+            *l = k;
+        }
+        let index = |x: Vec3<T>| rim.iter().position(|&y| y == x);
+        let mut changed = true;
+        while changed {
+            changed = false;
+            for &(v, w, _) in open() {
+                let (Some(i), Some(j)) = (index(v), index(w)) else { return false };
+                let (Some(&li), Some(&lj)) = (label.get(i), label.get(j)) else { return false };
+                if li != lj {
+                    let low = li.min(lj);
+                    for l in label.iter_mut().take(rim.len()) {
+                        if *l == li || *l == lj {
+                            *l = low;
+                        }
+                    }
+                    changed = true;
+                }
+            }
+        }
+        for loop_label in 0..rim.len() {
+            let in_loop = |x: &&Vec3<T>| index(**x).and_then(|i| label.get(i)) == Some(&loop_label);
+            let points = || rim.iter().filter(in_loop);
+            let Some(&first) = points().next() else { continue };
+            // The loop's plane from its first point and the two spanning the largest triangle.
+            let far = points().fold(first, |m, &x| if (x - first).norm2() > (m - first).norm2() { x } else { m });
+            let normal = points().fold(Vec3::ZERO, |m, &x| {
+                let n = (far - first).cross(x - first);
+                if n.norm2() > m.norm2() {
+                    n
+                } else {
+                    m
+                }
+            });
+            let length = normal.norm();
+            if !(length > T::ZERO) {
+                return false;
+            }
+            let height = |x: Vec3<T>| normal.dot(x - first) / length;
+            let planar = points().all(|&x| height(x).abs() <= tolerance);
+            let (above, below) = self
+                .vertices()
+                .iter()
+                .fold((false, false), |(a, b), &x| (a || height(x) > tolerance, b || height(x) < -tolerance));
+            let covered = self.facets().any(|facet| facet.iter().all(|&x| height(x).abs() <= tolerance));
+            if !planar || (above && below) || covered {
+                return false;
+            }
+            let loop_points = || points().copied();
+            let mut face = [Vec3::ZERO; MAX_VERTICES];
+            let mut m = 0usize;
+            for (slot, x) in face.iter_mut().zip(loop_points()) {
+                *slot = x;
+                m += 1;
+            }
+            let face = face.get(..m).unwrap_or_default();
+            let edges =
+                open().filter(|e| index(e.0).and_then(|i| label.get(i)) == Some(&loop_label)).map(|&(v, w, _)| w - v);
+            if !separated(face, edges, core::iter::once(normal), ac, bc, tolerance) {
+                return false;
+            }
+        }
+        true
+    }
+}
+
+/// Groups the casters into convex solids: each crossed polygon not yet in one starts a solid,
+/// which takes in every polygon sharing an edge with it for as long as all their vertices stay
+/// on one side of every member's plane (so a cabinet standing in a hole of the floor does not
+/// take in the floor, whose facets share its bottom edges). Polygons in no solid cannot cut.
+/// The labels (0: none, k: solid k) and the number of solids; `None` for more than
+/// [`MAX_SOLIDS`].
+fn label_solids<T: Real>(casters: &[CasterPolygon<T>], tolerance: T) -> Option<([u8; MAX_CASTERS], u8)> {
+    let corners = |k: usize| casters.get(k).map(|(c, n, _)| c.get(..*n).unwrap_or_default()).unwrap_or_default();
+    let share_edge = |i: usize, j: usize| {
+        let (p, q) = (corners(i), corners(j));
+        let edge = |c: &[Vec3<T>], k: usize| (c.get(k).copied(), c.get((k + 1) % c.len().max(1)).copied());
+        (0..p.len()).any(|k| {
+            let (v, w) = edge(p, k);
+            v != w && (0..q.len()).any(|m| edge(q, m) == (w, v) || edge(q, m) == (v, w))
+        })
+    };
+    // The sides (1: above, 2: below) of polygon k's plane that the points lie on.
+    let sides = |k: usize, points: &mut dyn Iterator<Item = Vec3<T>>| {
+        let Some((o, n)) = plane_of(corners(k)) else { return 3u8 };
+        points.fold(0u8, |f, v| {
+            let h = n.dot(v - o);
+            f | u8::from(h > tolerance) | (u8::from(h < -tolerance) << 1)
+        })
+    };
+    let n = casters.len().min(MAX_CASTERS);
+    let mut label = [0u8; MAX_CASTERS];
+    // The sides of each member's plane its solid's vertices lie on.
+    let mut side = [0u8; MAX_CASTERS];
+    let mut count = 0u8;
+    for seed in 0..n {
+        if !casters.get(seed).is_some_and(|c| c.2) || label.get(seed) != Some(&0) {
+            continue;
+        }
+        count += 1;
+        if usize::from(count) > MAX_SOLIDS {
+            return None;
+        }
+        let (Some(l), Some(f)) = (label.get_mut(seed), side.get_mut(seed)) else { return None };
+        *l = count;
+        *f = 0;
+        // The crossed polygons first: an uncrossed neighbour taken in early (the floor around
+        // a cabinet's foot) could keep out the solid's own facets.
+        for crossed_only in [true, false] {
+            let mut grew = true;
+            while grew {
+                grew = false;
+                for j in 0..n {
+                    let candidate = label.get(j) == Some(&0) && (!crossed_only || casters.get(j).is_some_and(|c| c.2));
+                    if !candidate || !(0..n).any(|i| label.get(i) == Some(&count) && share_edge(i, j)) {
+                        continue;
+                    }
+                    let members = || (0..n).filter(|&i| label.get(i) == Some(&count));
+                    let own =
+                        sides(j, &mut members().chain(core::iter::once(j)).flat_map(|i| corners(i).iter().copied()));
+                    let joins = own != 3
+                        && members()
+                            .all(|i| side.get(i).is_some_and(|&f| f | sides(i, &mut corners(j).iter().copied()) != 3));
+                    if joins {
+                        for i in members() {
+                            if let Some(f) = side.get_mut(i) {
+                                *f |= sides(i, &mut corners(j).iter().copied());
+                            }
+                        }
+                        let (Some(l), Some(f)) = (label.get_mut(j), side.get_mut(j)) else { return None };
+                        *l = count;
+                        *f = own;
+                        grew = true;
+                    }
+                }
+            }
+        }
+    }
+    Some((label, count))
+}
+
+/// A convex set for the separating-axis tests between occluders: the hull of `points` grown by
+/// `radius` (a solid's vertices with radius zero, a sphere's centre with its radius), with its
+/// edges and facet normals as candidate axes.
+struct Hull<T> {
+    points: [Vec3<T>; MAX_VERTICES],
+    n_points: usize,
+    radius: T,
+    edges: [(Vec3<T>, Vec3<T>); MAX_EDGES],
+    n_edges: usize,
+    normals: [Vec3<T>; MAX_FACETS],
+    n_normals: usize,
+}
+
+impl<T: Real> Hull<T> {
+    fn empty() -> Self {
+        Self {
+            points: [Vec3::ZERO; MAX_VERTICES],
+            n_points: 0,
+            radius: T::ZERO,
+            edges: [(Vec3::ZERO, Vec3::ZERO); MAX_EDGES],
+            n_edges: 0,
+            normals: [Vec3::ZERO; MAX_FACETS],
+            n_normals: 0,
+        }
+    }
+
+    /// The solid's hull; `None` on overflow.
+    fn of_solid(solid: &Solid<T>) -> Option<Self> {
+        let mut hull = Self::empty();
+        for (slot, &v) in hull.points.iter_mut().zip(solid.vertices()) {
+            *slot = v;
+        }
+        hull.n_points = solid.n_vertices.min(MAX_VERTICES);
+        for (slot, &(v, w, _)) in hull.edges.iter_mut().zip(solid.edges()) {
+            *slot = (v, w);
+        }
+        hull.n_edges = solid.n_edges.min(MAX_EDGES);
+        for facet in solid.facets() {
+            *hull.normals.get_mut(hull.n_normals)? = plane_of(facet)?.1;
+            hull.n_normals += 1;
+        }
+        Some(hull)
+    }
+
+    fn of_ball(ball: &Ball<T>) -> Self {
+        let mut hull = Self::empty();
+        if let Some(slot) = hull.points.first_mut() {
+            *slot = ball.center;
+            hull.n_points = 1;
+        }
+        hull.radius = ball.radius;
+        hull
+    }
+
+    /// A parallelogram's hull (its corners in order).
+    fn of_quad(corners: &[Vec3<T>; 4]) -> Self {
+        let mut hull = Self::empty();
+        for (k, &c) in corners.iter().enumerate() {
+            if let (Some(point), Some(edge), Some(&next)) =
+                (hull.points.get_mut(k), hull.edges.get_mut(k), corners.get((k + 1) % 4))
+            {
+                (*point, *edge) = (c, (c, next));
+                hull.n_points += 1;
+                hull.n_edges += 1;
+            }
+        }
+        if let (Some((_, n)), Some(slot)) = (plane_of(corners), hull.normals.first_mut()) {
+            *slot = n;
+            hull.n_normals = 1;
+        }
+        hull
+    }
+
+    fn points(&self) -> &[Vec3<T>] {
+        self.points.get(..self.n_points).unwrap_or_default()
+    }
+
+    fn edges(&self) -> &[(Vec3<T>, Vec3<T>)] {
+        self.edges.get(..self.n_edges).unwrap_or_default()
+    }
+
+    fn normals(&self) -> &[Vec3<T>] {
+        self.normals.get(..self.n_normals).unwrap_or_default()
+    }
+
+    fn centre(&self) -> Vec3<T> {
+        let sum = self.points().iter().fold(Vec3::ZERO, |m, &v| m + v);
+        sum.scale(T::ONE / T::from_f64(self.n_points.max(1) as f64))
+    }
+
+    /// The projection onto `axis`.
+    fn range(&self, axis: Vec3<T>) -> (T, T) {
+        let grow = self.radius * axis.norm();
+        let (lo, hi) = self.points().iter().fold((T::MAX, -T::MAX), |(lo, hi), &x| {
+            let d = axis.dot(x);
+            (lo.min(d), hi.max(d))
+        });
+        (lo - grow, hi + grow)
+    }
+}
+
+/// Whether `y` and the hull of `p` ∪ `x` are apart by more than `tolerance` along one of the
+/// candidate axes: the coordinate axes, the directions between their centres, their facet
+/// normals, the planes through an edge of `p` and a point of `x` (tangent to `x` for a ball)
+/// or an edge of `x` and a point of `p` (the faces of that hull), and the cross products of
+/// `y`'s edges with the others'. An axis missed keeps the two together, which declines the
+/// events, never costs accuracy.
+fn apart_from_hull<T: Real>(y: &Hull<T>, p: &Hull<T>, x: &Hull<T>, tolerance: T) -> bool {
+    let test = |axis: Vec3<T>| {
+        let length = axis.norm();
+        if !(length > T::ZERO) {
+            return false;
+        }
+        let (y0, y1) = y.range(axis);
+        let ((p0, p1), (x0, x1)) = (p.range(axis), x.range(axis));
+        let slack = tolerance * length;
+        y1 < p0.min(x0) - slack || p1.max(x1) < y0 - slack
+    };
+    let (o, i) = (T::ZERO, T::ONE);
+    let coordinate = [vec3(i, o, o), vec3(o, i, o), vec3(o, o, i)];
+    if coordinate.into_iter().any(test) || test(y.centre() - x.centre()) || test(y.centre() - p.centre()) {
+        return true;
+    }
+    if y.normals().iter().chain(x.normals()).chain(p.normals()).any(|&n| test(n)) {
+        return true;
+    }
+    if y.radius > T::ZERO && x.points().iter().chain(p.points()).any(|&q| test(y.centre() - q)) {
+        return true;
+    }
+    for &(v, w) in p.edges() {
+        for &q in x.points() {
+            let found = if x.radius > T::ZERO {
+                tangent_normals(v, w, q, x.radius).into_iter().flatten().any(test)
+            } else {
+                test((w - v).cross(q - v))
+            };
+            if found {
+                return true;
+            }
+        }
+    }
+    if x.edges().iter().any(|&(v, w)| p.points().iter().any(|&c| test((w - v).cross(c - v)))) {
+        return true;
+    }
+    y.edges().iter().any(|&(v, w)| x.edges().iter().chain(p.edges()).any(|&(e0, e1)| test((w - v).cross(e1 - e0))))
+}
+
+/// The normals of the two planes through the line v → w tangent to the ball (c, r); none where
+/// the line meets the ball.
+fn tangent_normals<T: Real>(v: Vec3<T>, w: Vec3<T>, c: Vec3<T>, r: T) -> [Option<Vec3<T>>; 2] {
+    let d = w - v;
+    let (dd, m) = (d.norm2(), c - v);
+    if !(dd > T::ZERO) {
+        return [None, None];
+    }
+    let u = m - d.scale(d.dot(m) / dd);
+    let h = u.norm();
+    if !(h > r) {
+        return [None, None];
+    }
+    let e1 = u.scale(T::ONE / h);
+    let e2 = d.cross(e1).scale(T::ONE / dd.sqrt());
+    let sin = r / h;
+    let cos = (T::ONE - sin * sin).max(T::ZERO).sqrt();
+    [Some(e1.scale(sin) + e2.scale(cos)), Some(e1.scale(sin) - e2.scale(cos))]
+}
+
+/// Whether no segment from a (corners `a`) to b (`b`) can meet both `x` and `y`: a segment
+/// meeting x before y meets y within the hull of x and b, one meeting y first within the hull
+/// of a and x; so y apart from both hulls suffices, as does x apart from the hulls of a and y
+/// and of y and b. Then the two shadows never meet on b, and J's structure changes only at
+/// each one's own events.
+fn shadows_apart<T: Real>(x: &Hull<T>, y: &Hull<T>, a: &Hull<T>, b: &Hull<T>, tolerance: T) -> bool {
+    (apart_from_hull(y, a, x, tolerance) && apart_from_hull(y, b, x, tolerance))
+        || (apart_from_hull(x, a, y, tolerance) && apart_from_hull(x, b, y, tolerance))
 }
 
 /// The distance from the segment [c0, c1] to the convex polygon (zero where they meet).
@@ -347,14 +659,16 @@ fn facet_separated<T: Real>(facet: &[Vec3<T>], a: &[Vec3<T>; 4], b: &[Vec3<T>; 4
 impl<T: Real> PolygonEvents<T> {
     /// The events of outer a (affine map `outer` over `outer_rect`) against the parallelogram b
     /// (affine map `inner` over `rect`, inside `bounds`) across `occluders` (module docs);
-    /// `None` where an occluder that may cut is not a flat convex polygon, the polygons are not
-    /// one convex polygon or one convex solid's facets, b straddles a's plane, or the lines
-    /// overflow [`MAX_POLYGON_EVENT_CURVES`]. The lines are kinks between analytic sides, and the
+    /// `None` where an occluder that may cut is neither a flat convex polygon nor one sphere,
+    /// the polygons are not the facets of at most [`MAX_SOLIDS`] convex solids, two solids' (or a
+    /// solid's and the sphere's) shadows may meet on b, a sphere is the only occluder near
+    /// (`Events::new` places it), b straddles a's plane, or the curves overflow
+    /// [`MAX_POLYGON_EVENT_CURVES`]. The lines are kinks between analytic sides, and the
     /// outer rule takes them as plain breaks, except where a comes very near b (`near`: a cut
     /// into cells graded towards b): there the lines run into the contact, where J is singular,
     /// and the rule is graded towards them (perpendicular squares sharing an edge, a screen on
     /// it: 3e-8 at order 10 graded, 8e-6 not). `clear_of` (c₀, c₁, d): `None` also where a
-    /// facet of the solid comes closer than d to the segment [c₀, c₁].
+    /// facet of a solid, or the sphere, comes closer than d to the segment [c₀, c₁].
     pub(super) fn polygons<O: Occluder<T> + ?Sized>(
         (outer, outer_rect): MappedRect<T>,
         (inner, rect): MappedRect<T>,
@@ -366,16 +680,29 @@ impl<T: Real> PolygonEvents<T> {
         let (bo, bt, bs) = inner;
         let (ac, bc) = (map_corners(outer, outer_rect), map_corners(inner, rect));
         if straddles(outer, bo, &bc) {
-            return None;
+            {
+                return None;
+            };
         }
         let centre = ac.iter().fold(Vec3::ZERO, |m, &c| m + c).scale(T::ONE / T::from_f64(4.0));
         let radius = ac.iter().fold(T::ZERO, |m, &c| m.max((c - centre).norm()));
         let from = Ball { center: centre, radius };
         let size = ac.iter().chain(bc.iter()).fold(T::ZERO, |m, &c| m.max((c - centre).norm()));
         let tolerance = size * T::GEOMETRY_TOLERANCE;
-        // Every polygon that may cut, and whether a segment from a to b can cross it.
+        let (a_hull, b_hull) = (Hull::of_quad(&ac), Hull::of_quad(&bc));
+        // A polygon on or behind a's plane or b's (their radiating sides) cannot cut a
+        // segment between points of a and b in front of each other: the rest of a box one of
+        // whose facets is a or b.
+        let (na, nb) = (outer.1.cross(outer.2), bt.cross(bs));
+        let behind = |corners: &[Vec3<T>]| {
+            let below = |o: Vec3<T>, n: Vec3<T>| corners.iter().all(|&c| n.dot(c - o) <= tolerance * n.norm());
+            below(outer.0, na) || below(bo, nb)
+        };
+        // Every polygon that may cut, and whether a segment from a to b can cross it; the one
+        // sphere that can.
         let mut casters = [([Vec3::ZERO; FACET_CORNERS], 0usize, false); MAX_CASTERS];
         let mut n_casters = 0usize;
+        let mut sphere = None;
         let mut fits = true;
         let supported = occluders.shadow_casters(&from, &bc, bounds, &mut |caster| match caster {
             Caster::Polygon(corners) => match (casters.get_mut(n_casters), corners.len() <= FACET_CORNERS) {
@@ -383,29 +710,35 @@ impl<T: Real> PolygonEvents<T> {
                     for (x, &c) in slot.0.iter_mut().zip(corners) {
                         *x = c;
                     }
-                    *slot = (slot.0, corners.len(), !facet_separated(corners, &ac, &bc, tolerance));
+                    let crossed = !behind(corners) && !facet_separated(corners, &ac, &bc, tolerance);
+                    *slot = (slot.0, corners.len(), crossed);
                     n_casters += 1;
                 }
                 _ => fits = false,
             },
-            Caster::Sphere(_) => fits = false,
+            Caster::Sphere(ball) => {
+                if !apart_from_hull(&Hull::of_ball(&ball), &a_hull, &b_hull, tolerance) {
+                    fits &= sphere.is_none();
+                    sphere = Some(ball);
+                }
+            }
         });
         if !supported || !fits {
-            return None;
+            {
+                return None;
+            };
         }
         let casters = casters.get(..n_casters).unwrap_or_default();
-        let solid = Solid::of_cutting_component(casters)?;
-        if solid.n_facets > 1 && !solid.convex(&ac, &bc, tolerance) {
-            return None;
-        }
-        if let Some((c0, c1, clearance)) = clear_of {
-            if solid.facets().any(|facet| !(segment_to_polygon(c0, c1, facet) >= clearance)) {
+        let (labels, solids) = label_solids(casters, tolerance)?;
+        if n_casters == 0 && sphere.is_some() {
+            // A sphere alone, with no polygon near: `Events::new` places its quadrics (for a
+            // touching pair, the pair takes its other route).
+            {
                 return None;
-            }
+            };
         }
         let mut events = Self::empty(near, Some(outer_rect));
         let mut room = true;
-        let nb = bt.cross(bs);
         let unit_b = nb.scale(T::ONE / nb.norm());
         // Above b's plane by more than rounding: a vertex there has a shadow that moves with p.
         let above_b = |x: Vec3<T>| unit_b.dot(x - bo) > tolerance;
@@ -417,21 +750,90 @@ impl<T: Real> PolygonEvents<T> {
                 room &= events.push_line(outer, outer_rect, Quadric::plane(x, n).guarded(n.cross(u), w.cross(n)));
             }
         };
-        for &v in solid.vertices().iter().filter(|&&v| above_b(v)) {
-            for k in 0..4 {
-                let (Some(&c), Some(&d)) = (bc.get(k), bc.get((k + 1) % 4)) else { return None };
-                wedge_plane(&mut events, v, c - v, d - v);
-            }
-        }
-        for &(v, w, _) in solid.edges().iter().filter(|e| above_b(e.0) || above_b(e.1)) {
-            for &c in &bc {
-                wedge_plane(&mut events, c, v - c, w - c);
-            }
-        }
         let mut planes = true;
-        for facet in solid.facets() {
-            let (origin, normal) = plane_of(facet)?;
-            planes &= events.push_line(outer, outer_rect, Quadric::plane(origin, normal));
+        let mut hulls: [Option<Hull<T>>; MAX_SOLIDS + 1] = core::array::from_fn(|_| None);
+        for (label, hull) in (1..=solids).zip(hulls.iter_mut()) {
+            let solid = Solid::of_label(casters, &labels, label)?;
+            if solid.n_facets > 1 && !solid.convex(&ac, &bc, tolerance) {
+                {
+                    return None;
+                };
+            }
+            if let Some((c0, c1, clearance)) = clear_of {
+                if solid.facets().any(|facet| !(segment_to_polygon(c0, c1, facet) >= clearance)) {
+                    {
+                        return None;
+                    };
+                }
+            }
+            for &v in solid.vertices().iter().filter(|&&v| above_b(v)) {
+                for k in 0..4 {
+                    let (Some(&c), Some(&d)) = (bc.get(k), bc.get((k + 1) % 4)) else {
+                        {
+                            return None;
+                        }
+                    };
+                    wedge_plane(&mut events, v, c - v, d - v);
+                }
+            }
+            for &(v, w, _) in solid.edges().iter().filter(|e| above_b(e.0) || above_b(e.1)) {
+                for &c in &bc {
+                    wedge_plane(&mut events, c, v - c, w - c);
+                }
+            }
+            for facet in solid.facets() {
+                let (origin, normal) = plane_of(facet)?;
+                planes &= events.push_line(outer, outer_rect, Quadric::plane(origin, normal));
+                // A facet standing on a side of a (a cabinet's side on the floor's edge):
+                // J is singular along that side, and the rule is graded towards it.
+                for (k, (i, j)) in [(3, 0), (1, 2), (0, 1), (2, 3)].into_iter().enumerate() {
+                    if let (Some(&c0), Some(&c1)) = (ac.get(i), ac.get(j)) {
+                        if segment_to_polygon(c0, c1, facet) <= tolerance {
+                            events.grade_side(k);
+                        }
+                    }
+                }
+            }
+            *hull = Some(Hull::of_solid(&solid)?);
+        }
+        if let Some(ball) = sphere {
+            if let Some((c0, c1, clearance)) = clear_of {
+                if !(segment_to_segment(c0, c1, ball.center, ball.center) - ball.radius >= clearance) {
+                    {
+                        return None;
+                    };
+                }
+            }
+            // The sphere's shadow through b's corners and tangent to its edges, graded as in
+            // `Events::new`.
+            let quadrics = Sphere::outer(ball.center, ball.radius).ok()?;
+            events.set_grade(true);
+            for k in 0..4 {
+                let (Some(&c), Some(&d)) = (bc.get(k), bc.get((k + 1) % 4)) else {
+                    {
+                        return None;
+                    }
+                };
+                let supported =
+                    Occluder::event_quadrics(&quadrics, c, d - c, &mut |q| room &= events.push_quadric(outer, q));
+                if !supported {
+                    {
+                        return None;
+                    };
+                }
+            }
+            events.set_grade(near);
+            *hulls.get_mut(usize::from(solids))? = Some(Hull::of_ball(&ball));
+        }
+        // Two solids (or a solid and the sphere) whose shadows can meet on b would add the
+        // events where they meet.
+        let hulls = hulls.iter().flatten();
+        for (i, x) in hulls.clone().enumerate() {
+            if hulls.clone().skip(i + 1).any(|y| !shadows_apart(x, y, &a_hull, &b_hull, tolerance)) {
+                {
+                    return None;
+                };
+            }
         }
         planes &= events.push_line(outer, outer_rect, Quadric::plane(bo, unit_b));
         (room && planes).then_some(events)

@@ -275,3 +275,36 @@ pub(crate) fn straddles_curvature_cut<T: Real, const CA: usize, const CB: usize>
     }
     false
 }
+
+/// Which patch of an occluded pair goes outside with its outer events placed into the rule
+/// ([`crate::boundary::outer_events_apply`]): `preferred` (`true`: b) where its events are
+/// placed; the other where `preferred`'s are placed but an occluder touches it (a cabinet's
+/// foot on a floor facet's edge makes J singular there, and the floor facet outside converges
+/// only algebraically; the wall it faces, outside, is not touched) and the other's are placed;
+/// else `None`.
+#[cfg(feature = "closed-form")]
+pub(crate) fn events_outer<T, SA, SB, O>(
+    a: &Patch<'_, T, SA>,
+    b: &Patch<'_, T, SB>,
+    occluders: &O,
+    preferred: bool,
+) -> Option<bool>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
+    let state = |outer_b: bool| {
+        if outer_b {
+            crate::boundary::outer_events_state(b, a, occluders)
+        } else {
+            crate::boundary::outer_events_state(a, b, occluders)
+        }
+    };
+    match state(preferred) {
+        Some(true) => Some(preferred),
+        Some(false) => (state(!preferred) == Some(true)).then_some(!preferred),
+        None => None,
+    }
+}

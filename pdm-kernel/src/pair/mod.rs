@@ -384,10 +384,9 @@ where
         SeparateRoute::Occluded { outer_b } => {
             // With the outer events placed into the rule the outer patch needs no cells.
             #[cfg(feature = "closed-form")]
-            let events = if outer_b {
-                crate::boundary::outer_events_apply(pair.b, pair.a, occluders)
-            } else {
-                crate::boundary::outer_events_apply(pair.a, pair.b, occluders)
+            let (events, outer_b) = match events_outer(pair.a, pair.b, occluders, outer_b) {
+                Some(outer_b) => (true, outer_b),
+                None => (false, outer_b),
             };
             #[cfg(not(feature = "closed-form"))]
             let events = false;
