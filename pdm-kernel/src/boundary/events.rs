@@ -191,17 +191,7 @@ impl<T: Real, const N: usize, const SB: usize, const TB: usize> Events<T, N, SB,
         if straddles(outer, bo, &corners) {
             return None;
         }
-        for k in 0..4 {
-            let (Some(&c), Some(&next)) = (corners.get(k), corners.get((k + 1) % 4)) else { return None };
-            let mut given = 0usize;
-            let supported = occluders.event_quadrics(c, next - c, &mut |q| {
-                given += 1;
-                overflow |= !events.push_quadric(outer, q);
-            });
-            if !supported || given > QUADRICS_PER_CORNER {
-                return None;
-            }
-        }
+        overflow |= !events.push_edge_quadrics(outer, &corners, occluders)?;
         // b's plane: b faces p only on its front side.
         let nb = bt.cross(bs);
         overflow |= !events.push([T::ZERO, T::ZERO, T::ZERO, nb.dot(et), nb.dot(es), nb.dot(o - bo)], None);
@@ -232,6 +222,30 @@ impl<T: Real, const N: usize, const SB: usize, const TB: usize> Events<T, N, SB,
         let mut overflow = false;
         let supported = surface.event_quadrics(rect, &mut |q| overflow |= !events.push_quadric(outer, q));
         (supported && !overflow && events.n > 0).then_some(events)
+    }
+
+    /// Keeps the quadrics `occluders` give for each edge of b (`corners` in order around it:
+    /// [`Occluder::event_quadrics`]); `None` where an occluder gives none or more than
+    /// [`QUADRICS_PER_CORNER`] per edge (more than one sphere), else whether all fitted.
+    pub(super) fn push_edge_quadrics<O: Occluder<T> + ?Sized>(
+        &mut self,
+        outer: (Vec3<T>, Vec3<T>, Vec3<T>),
+        corners: &[Vec3<T>; 4],
+        occluders: &O,
+    ) -> Option<bool> {
+        let mut fitted = true;
+        for k in 0..4 {
+            let (Some(&c), Some(&next)) = (corners.get(k), corners.get((k + 1) % 4)) else { return None };
+            let mut given = 0usize;
+            let supported = occluders.event_quadrics(c, next - c, &mut |q| {
+                given += 1;
+                fitted &= self.push_quadric(outer, q);
+            });
+            if !supported || given > QUADRICS_PER_CORNER {
+                return None;
+            }
+        }
+        Some(fitted)
     }
 
     /// Keeps the quadric `q` restricted to a (affine map `outer`): with p = o + t·e_t + s·e_s and

@@ -680,9 +680,7 @@ impl<T: Real> PolygonEvents<T> {
         let (bo, bt, bs) = inner;
         let (ac, bc) = (map_corners(outer, outer_rect), map_corners(inner, rect));
         if straddles(outer, bo, &bc) {
-            {
-                return None;
-            };
+            return None;
         }
         let centre = ac.iter().fold(Vec3::ZERO, |m, &c| m + c).scale(T::ONE / T::from_f64(4.0));
         let radius = ac.iter().fold(T::ZERO, |m, &c| m.max((c - centre).norm()));
@@ -724,18 +722,14 @@ impl<T: Real> PolygonEvents<T> {
             }
         });
         if !supported || !fits {
-            {
-                return None;
-            };
+            return None;
         }
         let casters = casters.get(..n_casters).unwrap_or_default();
         let (labels, solids) = label_solids(casters, tolerance)?;
         if n_casters == 0 && sphere.is_some() {
             // A sphere alone, with no polygon near: `Events::new` places its quadrics (for a
             // touching pair, the pair takes its other route).
-            {
-                return None;
-            };
+            return None;
         }
         let mut events = Self::empty(near, Some(outer_rect));
         let mut room = true;
@@ -755,23 +749,17 @@ impl<T: Real> PolygonEvents<T> {
         for (label, hull) in (1..=solids).zip(hulls.iter_mut()) {
             let solid = Solid::of_label(casters, &labels, label)?;
             if solid.n_facets > 1 && !solid.convex(&ac, &bc, tolerance) {
-                {
-                    return None;
-                };
+                return None;
             }
             if let Some((c0, c1, clearance)) = clear_of {
                 if solid.facets().any(|facet| !(segment_to_polygon(c0, c1, facet) >= clearance)) {
-                    {
-                        return None;
-                    };
+                    return None;
                 }
             }
             for &v in solid.vertices().iter().filter(|&&v| above_b(v)) {
                 for k in 0..4 {
                     let (Some(&c), Some(&d)) = (bc.get(k), bc.get((k + 1) % 4)) else {
-                        {
-                            return None;
-                        }
+                        return None;
                     };
                     wedge_plane(&mut events, v, c - v, d - v);
                 }
@@ -799,29 +787,14 @@ impl<T: Real> PolygonEvents<T> {
         if let Some(ball) = sphere {
             if let Some((c0, c1, clearance)) = clear_of {
                 if !(segment_to_segment(c0, c1, ball.center, ball.center) - ball.radius >= clearance) {
-                    {
-                        return None;
-                    };
+                    return None;
                 }
             }
             // The sphere's shadow through b's corners and tangent to its edges, graded as in
             // `Events::new`.
-            let quadrics = Sphere::outer(ball.center, ball.radius).ok()?;
+            let sphere = Sphere::outer(ball.center, ball.radius).ok()?;
             events.set_grade(true);
-            for k in 0..4 {
-                let (Some(&c), Some(&d)) = (bc.get(k), bc.get((k + 1) % 4)) else {
-                    {
-                        return None;
-                    }
-                };
-                let supported =
-                    Occluder::event_quadrics(&quadrics, c, d - c, &mut |q| room &= events.push_quadric(outer, q));
-                if !supported {
-                    {
-                        return None;
-                    };
-                }
-            }
+            room &= events.push_edge_quadrics(outer, &bc, &sphere)?;
             events.set_grade(near);
             *hulls.get_mut(usize::from(solids))? = Some(Hull::of_ball(&ball));
         }
@@ -830,9 +803,7 @@ impl<T: Real> PolygonEvents<T> {
         let hulls = hulls.iter().flatten();
         for (i, x) in hulls.clone().enumerate() {
             if hulls.clone().skip(i + 1).any(|y| !shadows_apart(x, y, &a_hull, &b_hull, tolerance)) {
-                {
-                    return None;
-                };
+                return None;
             }
         }
         planes &= events.push_line(outer, outer_rect, Quadric::plane(bo, unit_b));
