@@ -32,9 +32,10 @@
 use super::*;
 use crate::visibility::Quadric;
 
-/// Most event curves on one outer patch: the occluder gives two per corner of b (a sphere:
-/// [`QUADRICS_PER_CORNER`]) and b's plane one.
-pub(crate) const MAX_EVENT_CURVES: usize = 4 * QUADRICS_PER_CORNER + 1;
+/// Most event curves on one outer patch: the occluder gives two per corner of the part of b
+/// that a sees (a sphere: [`QUADRICS_PER_CORNER`]; at most five corners where b straddles a's
+/// plane, `front_part`) and b's plane one.
+pub(crate) const MAX_EVENT_CURVES: usize = 5 * QUADRICS_PER_CORNER + 1;
 
 /// Most quadrics one corner may give: one occluder's (a sphere's tangent cone from the corner
 /// and its two tangent planes through the edge). Where more come, several occluders cast
@@ -173,10 +174,10 @@ impl<T: Real, const N: usize, const SB: usize, const TB: usize> Events<T, N, SB,
     }
 
     /// The events of outer a (affine map `outer`: p = o + t·e_t + s·e_s) against inner b (affine
-    /// map `inner` over the parameter rectangle `rect`) across `occluders`; `None` if an
-    /// occluder cannot give its quadrics, more than one occluder gives them
-    /// ([`QUADRICS_PER_CORNER`]), a coefficient is not finite, or b straddles a's plane (the part
-    /// of b in front of a then has an edge and corners that are not b's).
+    /// map `inner` over the parameter rectangle `rect`) across `occluders`, at the corners and
+    /// edges of the part of b in front of a's plane; `None` if an occluder cannot give its
+    /// quadrics, more than one occluder gives them ([`QUADRICS_PER_CORNER`]), or a coefficient
+    /// is not finite.
     pub(super) fn new<O: Occluder<T> + ?Sized>(
         outer: (Vec3<T>, Vec3<T>, Vec3<T>),
         inner: (Vec3<T>, Vec3<T>, Vec3<T>),
@@ -187,11 +188,10 @@ impl<T: Real, const N: usize, const SB: usize, const TB: usize> Events<T, N, SB,
         let (bo, bt, bs) = inner;
         let mut events = Self::empty(true, None);
         let mut overflow = false;
-        let corners = map_corners(inner, rect);
-        if straddles(outer, bo, &corners) {
-            return None;
-        }
-        overflow |= !events.push_edge_quadrics(outer, &corners, occluders)?;
+        // The part of b that a's points see (`front_part`: b clipped by a's plane where it
+        // straddles it) has the corners and edges whose quadrics are the events.
+        let (front, n_front) = front_part(outer, bo, &map_corners(inner, rect));
+        overflow |= !events.push_edge_quadrics(outer, front.get(..n_front).unwrap_or_default(), occluders)?;
         // b's plane: b faces p only on its front side.
         let nb = bt.cross(bs);
         overflow |= !events.push([T::ZERO, T::ZERO, T::ZERO, nb.dot(et), nb.dot(es), nb.dot(o - bo)], None);
@@ -224,18 +224,20 @@ impl<T: Real, const N: usize, const SB: usize, const TB: usize> Events<T, N, SB,
         (supported && !overflow && events.n > 0).then_some(events)
     }
 
-    /// Keeps the quadrics `occluders` give for each edge of b (`corners` in order around it:
-    /// [`Occluder::event_quadrics`]); `None` where an occluder gives none or more than
-    /// [`QUADRICS_PER_CORNER`] per edge (more than one sphere), else whether all fitted.
+    /// Keeps the quadrics `occluders` give for each edge of b's visible part (`corners` in
+    /// order around it, at most five: [`Occluder::event_quadrics`]); `None` where an occluder
+    /// gives none or more than [`QUADRICS_PER_CORNER`] per edge (more than one sphere), else
+    /// whether all fitted.
     pub(super) fn push_edge_quadrics<O: Occluder<T> + ?Sized>(
         &mut self,
         outer: (Vec3<T>, Vec3<T>, Vec3<T>),
-        corners: &[Vec3<T>; 4],
+        corners: &[Vec3<T>],
         occluders: &O,
     ) -> Option<bool> {
         let mut fitted = true;
-        for k in 0..4 {
-            let (Some(&c), Some(&next)) = (corners.get(k), corners.get((k + 1) % 4)) else { return None };
+        let count = corners.len();
+        for k in 0..count {
+            let (Some(&c), Some(&next)) = (corners.get(k), corners.get((k + 1) % count)) else { return None };
             let mut given = 0usize;
             let supported = occluders.event_quadrics(c, next - c, &mut |q| {
                 given += 1;

@@ -16,6 +16,9 @@
 //!   for a solid, a facet turns towards or away from p and the silhouette changes;
 //! * p crosses b's plane (b starts facing p).
 //!
+//! "b" is the part of b that a sees ([`front_part`]): where b straddles a's plane, it is b
+//! clipped by that plane, the same polygon from every point of a.
+//!
 //! All are planes, so on a flat a they are lines in a's parameters, each with a guard (the
 //! double wedge about the line through v, or through c, where the event is real) placed into
 //! the outer rule as [`Events`] places conics. A vertex or edge of O lying on or behind b's
@@ -287,6 +290,30 @@ impl<T: Real> Solid<T> {
             }
         }
         true
+    }
+}
+
+/// Moves each corner within `tolerance` of an earlier one (of any polygon) onto it: facets
+/// built from an origin and two edge vectors (a box of parallelograms) put a shared corner a
+/// few units of rounding apart, and the shared edges that make the facets one solid
+/// ([`label_solids`], [`Solid`]) are matched exactly. The events move by rounding; J, which
+/// takes the occluders as given, does not.
+fn snap_corners<T: Real>(casters: &mut [CasterPolygon<T>], tolerance: T) {
+    for i in 0..casters.len() {
+        let count = casters.get(i).map_or(0, |c| c.1);
+        for k in 0..count {
+            let Some(&c) = casters.get(i).and_then(|p| p.0.get(k)) else { continue };
+            let earlier = (0..=i).find_map(|j| {
+                let (corners, n, _) = casters.get(j)?;
+                let end = if j == i { k } else { *n };
+                corners.get(..end)?.iter().copied().find(|&d| d != c && (d - c).norm() <= tolerance)
+            });
+            if let Some(d) = earlier {
+                if let Some(slot) = casters.get_mut(i).and_then(|p| p.0.get_mut(k)) {
+                    *slot = d;
+                }
+            }
+        }
     }
 }
 
@@ -662,8 +689,9 @@ impl<T: Real> PolygonEvents<T> {
     /// `None` where an occluder that may cut is neither a flat convex polygon nor one sphere,
     /// the polygons are not the facets of at most [`MAX_SOLIDS`] convex solids, two solids' (or a
     /// solid's and the sphere's) shadows may meet on b, a sphere is the only occluder near
-    /// (`Events::new` places it), b straddles a's plane, or the curves overflow
-    /// [`MAX_POLYGON_EVENT_CURVES`]. The lines are kinks between analytic sides, and the
+    /// (`Events::new` places it), or the curves overflow [`MAX_POLYGON_EVENT_CURVES`]. Where b
+    /// straddles a's plane, the corners and edges are those of its part in front
+    /// ([`front_part`]). The lines are kinks between analytic sides, and the
     /// outer rule takes them as plain breaks, except where a comes very near b (`near`: a cut
     /// into cells graded towards b): there the lines run into the contact, where J is singular,
     /// and the rule is graded towards them (perpendicular squares sharing an edge, a screen on
@@ -679,9 +707,10 @@ impl<T: Real> PolygonEvents<T> {
     ) -> Option<Self> {
         let (bo, bt, bs) = inner;
         let (ac, bc) = (map_corners(outer, outer_rect), map_corners(inner, rect));
-        if straddles(outer, bo, &bc) {
-            return None;
-        }
+        // The events are those of the part of b in front of a's plane; the tests of which
+        // occluders may cut keep the whole of b (more segments: never fewer events).
+        let (front, n_front) = front_part(outer, bo, &bc);
+        let front = front.get(..n_front).unwrap_or_default();
         let centre = ac.iter().fold(Vec3::ZERO, |m, &c| m + c).scale(T::ONE / T::from_f64(4.0));
         let radius = ac.iter().fold(T::ZERO, |m, &c| m.max((c - centre).norm()));
         let from = Ball { center: centre, radius };
@@ -724,7 +753,9 @@ impl<T: Real> PolygonEvents<T> {
         if !supported || !fits {
             return None;
         }
-        let casters = casters.get(..n_casters).unwrap_or_default();
+        let casters = casters.get_mut(..n_casters).unwrap_or_default();
+        snap_corners(casters, tolerance);
+        let casters = &*casters;
         let (labels, solids) = label_solids(casters, tolerance)?;
         if n_casters == 0 && sphere.is_some() {
             // A sphere alone, with no polygon near: `Events::new` places its quadrics (for a
@@ -757,15 +788,15 @@ impl<T: Real> PolygonEvents<T> {
                 }
             }
             for &v in solid.vertices().iter().filter(|&&v| above_b(v)) {
-                for k in 0..4 {
-                    let (Some(&c), Some(&d)) = (bc.get(k), bc.get((k + 1) % 4)) else {
+                for k in 0..front.len() {
+                    let (Some(&c), Some(&d)) = (front.get(k), front.get((k + 1) % front.len())) else {
                         return None;
                     };
                     wedge_plane(&mut events, v, c - v, d - v);
                 }
             }
             for &(v, w, _) in solid.edges().iter().filter(|e| above_b(e.0) || above_b(e.1)) {
-                for &c in &bc {
+                for &c in front {
                     wedge_plane(&mut events, c, v - c, w - c);
                 }
             }
@@ -794,7 +825,7 @@ impl<T: Real> PolygonEvents<T> {
             // `Events::new`.
             let sphere = Sphere::outer(ball.center, ball.radius).ok()?;
             events.set_grade(true);
-            room &= events.push_edge_quadrics(outer, &bc, &sphere)?;
+            room &= events.push_edge_quadrics(outer, front, &sphere)?;
             events.set_grade(near);
             *hulls.get_mut(usize::from(solids))? = Some(Hull::of_ball(&ball));
         }
@@ -837,16 +868,47 @@ impl<T: Real> PolygonEvents<T> {
     }
 }
 
-/// Whether b (its `corners`; `origin` a point of its plane) has corners on both sides of a's
-/// plane beyond rounding: the visible part of b then has an edge and corners that are not b's.
-pub(super) fn straddles<T: Real>(outer: (Vec3<T>, Vec3<T>, Vec3<T>), origin: Vec3<T>, corners: &[Vec3<T>; 4]) -> bool {
+/// The part of b (its `corners` in order; `origin` a point of its plane) that points of a flat
+/// a can see: b itself where no corner lies behind a's plane beyond rounding, else b clipped by
+/// that plane (Sutherland–Hodgman against one plane: 3 to 5 corners, two of them on a's plane),
+/// with the number of corners; b's corners where none lies in front. From a point p of a flat
+/// a, p's tangent plane is a's plane, so J(p) is taken over this one fixed polygon
+/// (`Inner::clipped`), and its corners and edges are where J changes structure: a b that
+/// straddles a's plane (a wall against a table top) has the events of its front part.
+pub(super) fn front_part<T: Real>(
+    outer: (Vec3<T>, Vec3<T>, Vec3<T>),
+    origin: Vec3<T>,
+    corners: &[Vec3<T>; 4],
+) -> ([Vec3<T>; 5], usize) {
     let (o, et, es) = outer;
     let na = et.cross(es);
     let size = corners.iter().fold(T::ZERO, |m, &c| m.max((c - origin).norm())).max(et.norm()).max(es.norm());
     let band = na.norm() * size * T::GEOMETRY_TOLERANCE;
-    let (front, behind) = corners.iter().fold((false, false), |(f, b), &c| {
-        let h = na.dot(c - o);
-        (f || h > band, b || h < -band)
-    });
-    front && behind
+    let height = |c: Vec3<T>| na.dot(c - o);
+    let mut part = [Vec3::ZERO; 5];
+    let mut n = 0usize;
+    if corners.iter().all(|&c| height(c) >= -band) || corners.iter().all(|&c| height(c) <= band) {
+        for (slot, &c) in part.iter_mut().zip(corners) {
+            *slot = c;
+        }
+        return (part, 4);
+    }
+    for (k, &c) in corners.iter().enumerate() {
+        let Some(&next) = corners.get((k + 1) % 4) else { continue };
+        let (hc, hn) = (height(c), height(next));
+        let mut keep = |x: Vec3<T>| {
+            if let Some(slot) = part.get_mut(n) {
+                *slot = x;
+                n += 1;
+            }
+        };
+        if hc >= -band {
+            keep(c);
+        }
+        // An edge from one side to the other beyond the band: its point on a's plane.
+        if (hc > band && hn < -band) || (hc < -band && hn > band) {
+            keep(c + (next - c).scale(hc / (hc - hn)));
+        }
+    }
+    (part, n)
 }
