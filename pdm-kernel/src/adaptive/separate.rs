@@ -175,11 +175,26 @@ where
     // order, like a smooth pair: orders 4, 6, … compared as such, the larger patch halved at
     // `max_order`.
     #[cfg(feature = "closed-form")]
-    if let Some(outer_b) = crate::pair::events_outer(a, b, occluders, false) {
-        let eval = |order: usize| {
-            crate::pair::PairContext::<T, SA, SB, O, CAP>::new(a, b, occluders).boundary(order, outer_b, 1, occluders)
-        };
-        return by_order_doubling::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, eval, 4, Split::LargerChecked);
+    match crate::pair::occluded_outer(a, b, occluders, false) {
+        (true, outer_b) => {
+            let eval = |order: usize| {
+                crate::pair::PairContext::<T, SA, SB, O, CAP>::new(a, b, occluders)
+                    .boundary(order, outer_b, 1, occluders)
+            };
+            return by_order_doubling::<T, SA, SB, O, CAP>(
+                a,
+                b,
+                settings,
+                occluders,
+                depth,
+                eval,
+                4,
+                Split::LargerChecked,
+            );
+        }
+        // An occluder touches a and none touches b: b outside (the call with b first keeps it).
+        (false, true) => return across_boundaries::<T, SB, SA, O, CAP>(b, a, settings, occluders, depth),
+        (false, false) => {}
     }
     let leaf = across_leaf::<T, SA, SB, O, CAP>(a, b, settings, occluders)?;
     if leaf.converged || depth >= settings.max_depth {

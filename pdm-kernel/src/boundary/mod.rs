@@ -498,6 +498,27 @@ where
     }
 }
 
+/// Whether an occluder that may cut the flat pair touches `patch` (`polygon_events::occluders_touch`:
+/// J is singular along the contact, and the rule over that patch converges slowly); `None`
+/// where either patch is not flat or an occluder is neither a flat convex polygon nor a sphere.
+#[cfg(feature = "closed-form")]
+#[inline(never)]
+pub(crate) fn occluders_touch<T, SA, SB, O>(
+    patch: &Patch<'_, T, SA>,
+    other: &Patch<'_, T, SB>,
+    occluders: &O,
+) -> Option<bool>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
+    let (map, other_map) = (patch.surface().affine_map()?, other.surface().affine_map()?);
+    let bounds = part_ball(other.surface(), Some(other_map), other.rect()).ok()?;
+    polygon_events::occluders_touch((map, patch.rect()), &map_corners(other_map, other.rect()), occluders, &bounds)
+}
+
 /// Whether a flat pair's events across flat convex occluders are placed ([`PolygonEvents`]):
 /// `Some(true)` where they make the outer integral converge exponentially, `Some(false)` where
 /// an occluder touches the outer patch (a cabinet's corner on the floor's makes J singular

@@ -293,6 +293,39 @@ impl<T: Real> Solid<T> {
     }
 }
 
+/// Whether an occluder that may cut a segment from the parallelogram x (affine map `outer` over
+/// `outer_rect`) to the parallelogram y (corners `other`, inside `bounds`) touches x: a facet
+/// within the geometric tolerance of it (a box standing on the floor, its foot on a facet's
+/// edge), or a sphere. J(p) is singular along such a contact, and a rule over x converges
+/// slowly there. `None` where an occluder that may cut is neither a flat convex polygon nor a
+/// sphere ([`Occluder::shadow_casters`]).
+pub(super) fn occluders_touch<T: Real, O: Occluder<T> + ?Sized>(
+    (outer, outer_rect): MappedRect<T>,
+    other: &[Vec3<T>; 4],
+    occluders: &O,
+    bounds: &Ball<T>,
+) -> Option<bool> {
+    let xc = map_corners(outer, outer_rect);
+    let centre = xc.iter().fold(Vec3::ZERO, |m, &c| m + c).scale(T::ONE / T::from_f64(4.0));
+    let radius = xc.iter().fold(T::ZERO, |m, &c| m.max((c - centre).norm()));
+    let size = xc.iter().chain(other.iter()).fold(T::ZERO, |m, &c| m.max((c - centre).norm()));
+    let tolerance = size * T::GEOMETRY_TOLERANCE;
+    let mut touches = false;
+    let from = Ball { center: centre, radius };
+    let supported = occluders.shadow_casters(&from, other, bounds, &mut |caster| match caster {
+        Caster::Polygon(corners) => {
+            touches |= polygon_sides(corners).any(|(v, w)| segment_to_polygon(v, w, &xc) <= tolerance)
+                || polygon_sides(&xc).any(|(v, w)| segment_to_polygon(v, w, corners) <= tolerance);
+        }
+        Caster::Sphere(ball) => {
+            touches |= polygon_sides(&xc)
+                .any(|(v, w)| segment_to_segment(v, w, ball.center, ball.center) <= ball.radius + tolerance)
+                || segment_to_polygon(ball.center, ball.center, &xc) <= ball.radius + tolerance;
+        }
+    });
+    supported.then_some(touches)
+}
+
 /// Moves each corner within `tolerance` of an earlier one (of any polygon) onto it: facets
 /// built from an origin and two edge vectors (a box of parallelograms) put a shared corner a
 /// few units of rounding apart, and the shared edges that make the facets one solid
@@ -611,6 +644,12 @@ fn segment_to_segment<T: Real>(p0: Vec3<T>, p1: Vec3<T>, q0: Vec3<T>, q1: Vec3<T
     let s = ((b * f - c * e) / denom).max(T::ZERO).min(T::ONE);
     let t = ((b * s + f) / e).max(T::ZERO).min(T::ONE);
     ends.min((p0 + d1.scale(s) - q0 - d2.scale(t)).norm())
+}
+
+/// The sides of a closed polygon as pairs of corners.
+fn polygon_sides<T: Real>(p: &[Vec3<T>]) -> impl Iterator<Item = (Vec3<T>, Vec3<T>)> + '_ {
+    let n = p.len();
+    (0..n).filter_map(move |k| Some((*p.get(k)?, *p.get((k + 1) % n)?)))
 }
 
 /// The edge vectors of a closed polygon.

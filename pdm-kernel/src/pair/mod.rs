@@ -384,10 +384,7 @@ where
         SeparateRoute::Occluded { outer_b } => {
             // With the outer events placed into the rule the outer patch needs no cells.
             #[cfg(feature = "closed-form")]
-            let (events, outer_b) = match events_outer(pair.a, pair.b, occluders, outer_b) {
-                Some(outer_b) => (true, outer_b),
-                None => (false, outer_b),
-            };
+            let (events, outer_b) = occluded_outer(pair.a, pair.b, occluders, outer_b);
             #[cfg(not(feature = "closed-form"))]
             let events = false;
             let split = if events { 1 } else { OCCLUDED_OUTER_SPLIT };
