@@ -21,7 +21,9 @@
 //!    whole pair from the normal cones, `pair::facing_settled`; or an occluder that may cut)
 //!    or the patches are closer than their size; the outer patch is chosen as by `pair_exchange`: without
 //!    occluders the patch whose points stay farther from the other's edges
-//!    (`pair::outer_is_b`), across occluders the smaller one (`pair::occluded_outer_is_b`);
+//!    (`pair::outer_is_b`), across occluders the smaller one (`pair::occluded_outer_is_b`;
+//!    `pair::occluded_outer`: the one whose outer events are placed, and between patches of
+//!    one size the one no occluder touches);
 //! 4. compares orders p, p + 2, …; when the estimate is still above the tolerance at
 //!    `max_order`, splits the pair and recurses — a separate pair's larger patch in two across
 //!    its longer side, a touching pair's both patches 2 × 2 (so that the cells along the

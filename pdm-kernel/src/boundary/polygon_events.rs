@@ -318,9 +318,7 @@ pub(super) fn occluders_touch<T: Real, O: Occluder<T> + ?Sized>(
                 || polygon_sides(&xc).any(|(v, w)| segment_to_polygon(v, w, corners) <= tolerance);
         }
         Caster::Sphere(ball) => {
-            touches |= polygon_sides(&xc)
-                .any(|(v, w)| segment_to_segment(v, w, ball.center, ball.center) <= ball.radius + tolerance)
-                || segment_to_polygon(ball.center, ball.center, &xc) <= ball.radius + tolerance;
+            touches |= segment_to_polygon(ball.center, ball.center, &xc) <= ball.radius + tolerance;
         }
     });
     supported.then_some(touches)
