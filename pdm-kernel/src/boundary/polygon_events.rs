@@ -306,12 +306,8 @@ pub(super) fn occluders_touch<T: Real, O: Occluder<T> + ?Sized>(
     bounds: &Ball<T>,
 ) -> Option<bool> {
     let xc = map_corners(outer, outer_rect);
-    let centre = xc.iter().fold(Vec3::ZERO, |m, &c| m + c).scale(T::ONE / T::from_f64(4.0));
-    let radius = xc.iter().fold(T::ZERO, |m, &c| m.max((c - centre).norm()));
-    let size = xc.iter().chain(other.iter()).fold(T::ZERO, |m, &c| m.max((c - centre).norm()));
-    let tolerance = size * T::GEOMETRY_TOLERANCE;
+    let (from, tolerance) = outer_frame(&xc, other);
     let mut touches = false;
-    let from = Ball { center: centre, radius };
     let supported = occluders.shadow_casters(&from, other, bounds, &mut |caster| match caster {
         Caster::Polygon(corners) => {
             touches |= polygon_sides(corners).any(|(v, w)| segment_to_polygon(v, w, &xc) <= tolerance)
@@ -322,6 +318,16 @@ pub(super) fn occluders_touch<T: Real, O: Occluder<T> + ?Sized>(
         }
     });
     supported.then_some(touches)
+}
+
+/// The ball about the outer parallelogram's corners `ac` (from their centre) and the pair's
+/// geometric tolerance: `GEOMETRY_TOLERANCE` times the farthest corner of either from that
+/// centre.
+fn outer_frame<T: Real>(ac: &[Vec3<T>; 4], bc: &[Vec3<T>; 4]) -> (Ball<T>, T) {
+    let centre = ac.iter().fold(Vec3::ZERO, |m, &c| m + c).scale(T::ONE / T::from_f64(4.0));
+    let radius = ac.iter().fold(T::ZERO, |m, &c| m.max((c - centre).norm()));
+    let size = ac.iter().chain(bc.iter()).fold(T::ZERO, |m, &c| m.max((c - centre).norm()));
+    (Ball { center: centre, radius }, size * T::GEOMETRY_TOLERANCE)
 }
 
 /// Moves each corner within `tolerance` of an earlier one (of any polygon) onto it: facets
@@ -603,9 +609,7 @@ fn shadows_apart<T: Real>(x: &Hull<T>, y: &Hull<T>, a: &Hull<T>, b: &Hull<T>, to
 /// The distance from the segment [c0, c1] to the convex polygon (zero where they meet).
 fn segment_to_polygon<T: Real>(c0: Vec3<T>, c1: Vec3<T>, polygon: &[Vec3<T>]) -> T {
     let Some((o, n)) = plane_of(polygon) else { return T::ZERO };
-    let count = polygon.len();
-    let side = |k: usize| Some((*polygon.get(k)?, *polygon.get((k + 1) % count)?));
-    let inside = |x: Vec3<T>| (0..count).all(|k| side(k).is_none_or(|(v, w)| (w - v).cross(x - v).dot(n) >= T::ZERO));
+    let inside = |x: Vec3<T>| polygon_sides(polygon).all(|(v, w)| (w - v).cross(x - v).dot(n) >= T::ZERO);
     let (h0, h1) = (n.dot(c0 - o), n.dot(c1 - o));
     if h0 * h1 <= T::ZERO && h0 != h1 && inside(c0 + (c1 - c0).scale(h0 / (h0 - h1))) {
         return T::ZERO;
@@ -615,10 +619,10 @@ fn segment_to_polygon<T: Real>(c0: Vec3<T>, c1: Vec3<T>, polygon: &[Vec3<T>]) ->
         if inside(x - n.scale(h)) {
             h.abs()
         } else {
-            (0..count).filter_map(side).fold(T::MAX, |m, (v, w)| m.min(segment_to_segment(x, x, v, w)))
+            polygon_sides(polygon).fold(T::MAX, |m, (v, w)| m.min(segment_to_segment(x, x, v, w)))
         }
     };
-    let edges = (0..count).filter_map(side).fold(T::MAX, |m, (v, w)| m.min(segment_to_segment(c0, c1, v, w)));
+    let edges = polygon_sides(polygon).fold(T::MAX, |m, (v, w)| m.min(segment_to_segment(c0, c1, v, w)));
     to_point(c0).min(to_point(c1)).min(edges)
 }
 
@@ -652,8 +656,7 @@ fn polygon_sides<T: Real>(p: &[Vec3<T>]) -> impl Iterator<Item = (Vec3<T>, Vec3<
 
 /// The edge vectors of a closed polygon.
 fn polygon_edges<T: Real>(p: &[Vec3<T>]) -> impl Iterator<Item = Vec3<T>> + '_ {
-    let n = p.len();
-    (0..n).filter_map(move |k| Some(*p.get((k + 1) % n)? - *p.get(k)?))
+    polygon_sides(p).map(|(v, w)| w - v)
 }
 
 /// A point of the facet and its unit normal (Newell's sum, robust to a repeated corner).
@@ -748,11 +751,7 @@ impl<T: Real> PolygonEvents<T> {
         // occluders may cut keep the whole of b (more segments: never fewer events).
         let (front, n_front) = front_part(outer, bo, &bc);
         let front = front.get(..n_front).unwrap_or_default();
-        let centre = ac.iter().fold(Vec3::ZERO, |m, &c| m + c).scale(T::ONE / T::from_f64(4.0));
-        let radius = ac.iter().fold(T::ZERO, |m, &c| m.max((c - centre).norm()));
-        let from = Ball { center: centre, radius };
-        let size = ac.iter().chain(bc.iter()).fold(T::ZERO, |m, &c| m.max((c - centre).norm()));
-        let tolerance = size * T::GEOMETRY_TOLERANCE;
+        let (from, tolerance) = outer_frame(&ac, &bc);
         let (a_hull, b_hull) = (Hull::of_quad(&ac), Hull::of_quad(&bc));
         // A polygon on or behind a's plane or b's (their radiating sides) cannot cut a
         // segment between points of a and b in front of each other: the rest of a box one of

@@ -1132,6 +1132,24 @@ mod polygon_shadows {
 /// Pairs of `examples/scenes/room.toml`'s room (4 × 5 × 2.5, a table top as a closed slab, a
 /// cabinet standing in a hole of the floor without a bottom, a spherical lamp), each facet a
 /// parallelogram, the others as occluders.
+/// The six facets of the axis-aligned box from corner `lo` with sides `d`, each radiating
+/// outwards (top, bottom, the sides at y = lo, y = hi, x = lo, x = hi), as parallelograms from
+/// one corner and two edge vectors.
+fn box_facets(lo: [f64; 3], d: [f64; 3]) -> [pdm_kernel::Parallelogram<f64>; 6] {
+    let p = |o: [f64; 3], t: [f64; 3], s: [f64; 3]| {
+        pdm_kernel::Parallelogram::new(vec3(o[0], o[1], o[2]), vec3(t[0], t[1], t[2]), vec3(s[0], s[1], s[2])).unwrap()
+    };
+    let ([x0, y0, z0], [dx, dy, dz]) = (lo, d);
+    [
+        p([x0, y0, z0 + dz], [dx, 0.0, 0.0], [0.0, dy, 0.0]),
+        p([x0, y0, z0], [0.0, dy, 0.0], [dx, 0.0, 0.0]),
+        p([x0, y0, z0], [dx, 0.0, 0.0], [0.0, 0.0, dz]),
+        p([x0, y0 + dy, z0], [0.0, 0.0, dz], [dx, 0.0, 0.0]),
+        p([x0, y0, z0], [0.0, 0.0, dz], [0.0, dy, 0.0]),
+        p([x0 + dx, y0, z0], [0.0, dy, 0.0], [0.0, 0.0, dz]),
+    ]
+}
+
 /// Convex polygons in a plane, for the independent references below (written for these tests;
 /// nothing shared with the kernel).
 mod plane_polygons {
@@ -1426,18 +1444,7 @@ mod furnished_room {
         let p = |o: [f64; 3], t: [f64; 3], s: [f64; 3]| {
             Parallelogram::new(vec3(o[0], o[1], o[2]), vec3(t[0], t[1], t[2]), vec3(s[0], s[1], s[2])).unwrap()
         };
-        let boxed = |x0: f64| {
-            let (y0, z0, dx, dy, dz) = (1.5, 1.0, 0.5, 1.0, 1.0);
-            [
-                p([x0, y0, z0 + dz], [dx, 0.0, 0.0], [0.0, dy, 0.0]),
-                p([x0, y0, z0], [0.0, dy, 0.0], [dx, 0.0, 0.0]),
-                p([x0, y0, z0], [dx, 0.0, 0.0], [0.0, 0.0, dz]),
-                p([x0, y0 + dy, z0], [0.0, 0.0, dz], [dx, 0.0, 0.0]),
-                p([x0, y0, z0], [0.0, 0.0, dz], [0.0, dy, 0.0]),
-                p([x0 + dx, y0, z0], [0.0, dy, 0.0], [0.0, 0.0, dz]),
-            ]
-            .map(AnyOccluder::Parallelogram)
-        };
+        let boxed = |x0: f64| box_facets([x0, 1.5, 1.0], [0.5, 1.0, 1.0]).map(AnyOccluder::Parallelogram);
         let (first, second) = (boxed(0.5), boxed(3.0));
         let both: Vec<AnyOccluder<f64>> = first.iter().chain(second.iter()).copied().collect();
         let floor = p([0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]);
@@ -1577,17 +1584,7 @@ mod boxes_on_the_floor {
         let mut occluders = vec![];
         for (lo, hi) in boxes {
             let d = [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]];
-            occluders.extend(
-                [
-                    p([lo[0], lo[1], hi[2]], [d[0], 0.0, 0.0], [0.0, d[1], 0.0]),
-                    p(lo, [0.0, d[1], 0.0], [d[0], 0.0, 0.0]),
-                    p(lo, [d[0], 0.0, 0.0], [0.0, 0.0, d[2]]),
-                    p([lo[0], hi[1], lo[2]], [0.0, 0.0, d[2]], [d[0], 0.0, 0.0]),
-                    p(lo, [0.0, 0.0, d[2]], [0.0, d[1], 0.0]),
-                    p([hi[0], lo[1], lo[2]], [0.0, d[1], 0.0], [0.0, 0.0, d[2]]),
-                ]
-                .map(AnyOccluder::Parallelogram),
-            );
+            occluders.extend(box_facets(lo, d).map(AnyOccluder::Parallelogram));
         }
         let floor = p([0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]);
         let ceiling = p([0.0, 0.0, 3.0], [0.0, 4.0, 0.0], [4.0, 0.0, 0.0]);
