@@ -188,7 +188,7 @@ where
                 occluders,
                 depth,
                 eval,
-                4,
+                2,
                 Split::LargerChecked,
             );
         }

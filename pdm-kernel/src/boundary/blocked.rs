@@ -68,6 +68,12 @@ where
             trigonometric: false,
             outline: None,
             line_rule: GaussRule::<T>::new(order.max(16))?,
+            back_facets: match outer.affine_map() {
+                Some(outer_map) => {
+                    BackFacets::of_pair((outer_map, self.a.rect()), (self.map, r), self.occluders, &self.bounds)
+                }
+                None => BackFacets::none(),
+            },
             use_occluders: true,
             occluders: self.occluders,
             count: &count,

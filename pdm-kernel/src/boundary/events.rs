@@ -268,6 +268,12 @@ impl<T: Real, const N: usize, const SB: usize, const TB: usize> Events<T, N, SB,
         self.push(conic, guard)
     }
 
+    /// Keeps the line `line` (L(t, s) = a·t + b·s + c) as an event only between the guard
+    /// lines `from` and `to` (each positive on the side of the part kept); `false` on overflow.
+    pub(super) fn push_segment(&mut self, [a, b, c]: Line2<T>, from: Line2<T>, to: Line2<T>) -> bool {
+        self.push([T::ZERO, T::ZERO, T::ZERO, a, b, c], Some([scaled(from), scaled(to)]))
+    }
+
     /// Keeps a conic scaled to its largest coefficient 1 (the roots do not change, and the
     /// polynomials formed from it stay in range: a sphere's coefficients grow like the 6th
     /// power of the scene's size, their discriminants like the 12th); `false` for a

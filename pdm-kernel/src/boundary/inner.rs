@@ -32,6 +32,9 @@ pub(super) struct Inner<'x, T: Real, SB: Surface<T> + ?Sized, O: ?Sized> {
     /// outer point make J(p) exact to rounding at any outer order.
     #[cfg(feature = "closed-form")]
     pub(super) line_rule: GaussRule<T>,
+    /// Facets J(p) may leave out where they face away from p ([`BackFacets`]).
+    #[cfg(feature = "closed-form")]
+    pub(super) back_facets: BackFacets<T>,
     pub(super) use_occluders: bool,
     pub(super) occluders: &'x O,
     pub(super) count: &'x core::cell::Cell<u64>,

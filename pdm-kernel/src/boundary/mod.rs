@@ -246,6 +246,13 @@ where
         outline: if affine.is_none() { crate::contour::Outline::new(b) } else { None },
         #[cfg(feature = "closed-form")]
         line_rule: GaussRule::<T>::new(order.max(16))?,
+        #[cfg(feature = "closed-form")]
+        back_facets: match (a.surface().affine_map(), affine) {
+            (Some(outer_map), Some(inner_map)) if use_occluders => {
+                BackFacets::of_pair((outer_map, a.rect()), (inner_map, r), occluders, &inner_bounds)
+            }
+            _ => BackFacets::none(),
+        },
         use_occluders,
         occluders,
         count: &count,
@@ -889,6 +896,7 @@ mod tests {
             trigonometric: false,
             outline: None,
             line_rule: GaussRule::<f64>::new(20).unwrap(),
+            back_facets: BackFacets::none(),
             use_occluders,
             occluders,
             count: &count,

@@ -30,12 +30,22 @@
 //! through b's corners and tangent to b's edges) take the union of their events where their
 //! shadows can never meet on b: no segment from a to b meets two of them, which a
 //! separating-axis test proves ([`shadows_apart`]). J is then b less disjoint shadows, and its
-//! structure changes only at each one's own events. Where two shadows can meet, J also
-//! changes where a vertex of one's shadow crosses an edge of the other's (planes) and where two
-//! shadow edges cross on an edge of b (three lines meeting: quadric surfaces), dozens to
-//! hundreds of curves for two boxes, most of them inside the union of the shadows where
-//! nothing changes. Those pairs are declined (`None`): the outer rule samples across their
-//! events as before.
+//! structure changes only at each one's own events. Where two solids' shadows can meet, J also
+//! changes where a vertex of one's shadow crosses an edge of the other's (planes through a
+//! vertex of one solid and an edge of the other) and where two shadow edges cross on an edge
+//! of b (p on a line meeting three lines: a quadric), which `push_meeting` adds. Each event
+//! is kept only on the part of a where it can be real (`push_trimmed`: the ray through the
+//! vertex lands on the edge and in b, the edge is on its solid's outline seen from p; a
+//! quadric where its line meets b's edge segment and the fans through both solids' edges
+//! reach a). A sphere's shadow that can meet a solid's, or three solids' that can all meet,
+//! bring curves of other kinds: those pairs are declined (`None`), and the outer rule samples
+//! across their events as before.
+//!
+//! The outer rule is a tensor product: every curve's ends and crossings of a's t-edges are
+//! breaks along the whole of s, so n curves cost O(n²) pieces. Two boxes whose shadows meet
+//! give a few hundred curves and ~10⁵ outer points at order 4, where the value is exact to
+//! 1e-10; sampling across them instead is cheap per order but converges algebraically (the
+//! floor–ceiling pair above: 3.8e-4 off at order 8, 2.7e-5 at order 24).
 //!
 //! Occluders that cannot cut any segment from a to b (a separating plane between the occluder
 //! and the hull of a and b, or lying on or behind a's or b's plane) are left out first, so a
@@ -49,17 +59,22 @@
 
 use super::*;
 use crate::surface::Sphere;
+
 use crate::visibility::{Caster, Quadric};
 
-/// Most event lines of one pair across polygons: a box's eight vertices against b's four
-/// edges, its twelve edges against b's four corners, its six facet planes (86 before the guards
-/// cull those that miss a), with room for a pentagonal solid.
-pub(crate) const MAX_POLYGON_EVENT_CURVES: usize = 96;
+/// Most event curves of one pair across polygons. One box gives at most 86 lines (its eight
+/// vertices against b's four edges, its twelve edges against b's four corners, its six facet
+/// planes) before those that miss a are left out; two boxes whose shadows meet add up to 192
+/// vertex–edge planes and 576 three-line quadrics, of which a few hundred meet a (a floor and
+/// a ceiling 3 apart past a box on the floor and one above it: 266 curves in all). A pair
+/// whose curves overflow is declined: the outer rule samples across its events.
+pub(crate) const MAX_POLYGON_EVENT_CURVES: usize = 384;
 
-/// Breaks in s (each line crosses a's two t-edges and ends on its two guard lines) and along
-/// one outer line (one per line), ends included.
-const POLYGON_S_BREAKS: usize = 4 * MAX_POLYGON_EVENT_CURVES + 2;
-const POLYGON_T_BREAKS: usize = MAX_POLYGON_EVENT_CURVES + 2;
+/// Breaks in s (a line crosses a's two t-edges and ends on its two guard lines; a conic
+/// crosses each t-edge twice, is tangent to the t-lines twice and ends on its guard lines four
+/// times) and along one outer line (two per conic), ends included.
+const POLYGON_S_BREAKS: usize = 10 * MAX_POLYGON_EVENT_CURVES + 2;
+const POLYGON_T_BREAKS: usize = 2 * MAX_POLYGON_EVENT_CURVES + 2;
 
 /// A parallelogram: its affine map (origin, e_t, e_s) and parameter rectangle.
 pub(super) type MappedRect<T> = ((Vec3<T>, Vec3<T>, Vec3<T>), ParamRect<T>);
@@ -131,6 +146,31 @@ impl<T: Real> Solid<T> {
 
     fn edges(&self) -> &[(Vec3<T>, Vec3<T>, u8)] {
         self.edges.get(..self.n_edges).unwrap_or_default()
+    }
+
+    /// The outward unit normals of the (at most two) facets that have the edge v → w: the
+    /// edge is on the solid's outline seen from p exactly where p is outside one of them and
+    /// not the other.
+    fn edge_normals(&self, v: Vec3<T>, w: Vec3<T>) -> [Option<Vec3<T>>; 2] {
+        let centre = self
+            .vertices()
+            .iter()
+            .fold(Vec3::ZERO, |m, &x| m + x)
+            .scale(T::ONE / T::from_f64(self.n_vertices.max(1) as f64));
+        let mut found = [None, None];
+        let mut k = 0usize;
+        for facet in self.facets() {
+            if !polygon_sides(facet).any(|(x, y)| (x == v && y == w) || (x == w && y == v)) {
+                continue;
+            }
+            let Some((o, n)) = plane_of(facet) else { continue };
+            let outward = if n.dot(centre - o) > T::ZERO { -n } else { n };
+            if let Some(slot) = found.get_mut(k) {
+                *slot = Some(outward);
+                k += 1;
+            }
+        }
+        found
     }
 
     /// Adds a facet (repeated corners dropped) with its vertices and edges; `None` on overflow.
@@ -328,6 +368,140 @@ fn outer_frame<T: Real>(ac: &[Vec3<T>; 4], bc: &[Vec3<T>; 4]) -> (Ball<T>, T) {
     let radius = ac.iter().fold(T::ZERO, |m, &c| m.max((c - centre).norm()));
     let size = ac.iter().chain(bc.iter()).fold(T::ZERO, |m, &c| m.max((c - centre).norm()));
     (Ball { center: centre, radius }, size * T::GEOMETRY_TOLERANCE)
+}
+
+/// The polygons that may cut a pair, their number, and the one sphere that may ([`pair_casters`]).
+type PairCasters<T> = ([CasterPolygon<T>; MAX_CASTERS], usize, Option<Ball<T>>);
+
+/// Every polygon that may cut a segment from a (affine map `outer`, corners `ac`) to b
+/// (corners `bc`, normal `nb`), with whether a segment from a to b can cross it (else it only
+/// closes a solid: [`label_solids`]), their number, and the one sphere that can cut; `None`
+/// where an occluder is neither, a polygon has too many corners, there are too many, or two
+/// spheres can cut.
+fn pair_casters<T: Real, O: Occluder<T> + ?Sized>(
+    outer: (Vec3<T>, Vec3<T>, Vec3<T>),
+    (ac, bc): (&[Vec3<T>; 4], &[Vec3<T>; 4]),
+    nb: Vec3<T>,
+    occluders: &O,
+    bounds: &Ball<T>,
+) -> Option<PairCasters<T>> {
+    let (from, tolerance) = outer_frame(ac, bc);
+    let (a_hull, b_hull) = (Hull::of_quad(ac), Hull::of_quad(bc));
+    let bo = *bc.first()?;
+    // A polygon on or behind a's plane or b's (their radiating sides) cannot cut a segment
+    // between points of a and b in front of each other: the rest of a box one of whose facets
+    // is a or b.
+    let na = outer.1.cross(outer.2);
+    let behind = |corners: &[Vec3<T>]| {
+        let below = |o: Vec3<T>, n: Vec3<T>| corners.iter().all(|&c| n.dot(c - o) <= tolerance * n.norm());
+        below(outer.0, na) || below(bo, nb)
+    };
+    let mut casters = [([Vec3::ZERO; FACET_CORNERS], 0usize, false); MAX_CASTERS];
+    let mut n_casters = 0usize;
+    let mut sphere = None;
+    let mut fits = true;
+    let supported = occluders.shadow_casters(&from, bc, bounds, &mut |caster| match caster {
+        Caster::Polygon(corners) => match (casters.get_mut(n_casters), corners.len() <= FACET_CORNERS) {
+            (Some(slot), true) => {
+                for (x, &c) in slot.0.iter_mut().zip(corners) {
+                    *x = c;
+                }
+                let crossed = !behind(corners) && !facet_separated(corners, ac, bc, tolerance);
+                *slot = (slot.0, corners.len(), crossed);
+                n_casters += 1;
+            }
+            _ => fits = false,
+        },
+        Caster::Sphere(ball) => {
+            if !apart_from_hull(&Hull::of_ball(&ball), &a_hull, &b_hull, tolerance) {
+                fits &= sphere.is_none();
+                sphere = Some(ball);
+            }
+        }
+    });
+    (supported && fits).then_some((casters, n_casters, sphere))
+}
+
+/// Most facets J may skip ([`BackFacets`]).
+const MAX_BACK_FACETS: usize = MAX_CASTERS;
+
+/// The facets of a pair's convex solids (several facets each, [`Solid::convex`]) with their
+/// outward normals: from a point p of a outside such a solid, a facet that faces away from p
+/// hides nothing the facets facing p do not (a segment from p leaving the solid through it
+/// entered through a facet facing p, or through a part of the solid no facet covers, which
+/// `Solid::convex` proves no segment from a to b crosses), so J(p) may leave its shadow out
+/// (`Inner::point_past_polygons`). Each entry: the facet's first three corners as the
+/// occluder gives them and their number (to recognise it: facets of a box share corners, no
+/// two share three), its unit outward normal.
+pub(super) struct BackFacets<T> {
+    facets: [([Vec3<T>; 3], usize, Vec3<T>); MAX_BACK_FACETS],
+    n: usize,
+}
+
+impl<T: Real> BackFacets<T> {
+    /// No facet skipped.
+    pub(super) fn none() -> Self {
+        Self { facets: [([Vec3::ZERO; 3], 0, Vec3::ZERO); MAX_BACK_FACETS], n: 0 }
+    }
+
+    /// The facets of the convex solids among the occluders that may cut between the flat a
+    /// (affine map and rectangle `outer`) and the parallelogram b (`inner`, inside `bounds`);
+    /// none where the occluders are not all flat polygons and spheres or do not fit.
+    pub(super) fn of_pair<O: Occluder<T> + ?Sized>(
+        (outer, outer_rect): MappedRect<T>,
+        (inner, rect): MappedRect<T>,
+        occluders: &O,
+        bounds: &Ball<T>,
+    ) -> Self {
+        Self::find(outer, outer_rect, inner, rect, occluders, bounds).unwrap_or_else(Self::none)
+    }
+
+    fn find<O: Occluder<T> + ?Sized>(
+        outer: (Vec3<T>, Vec3<T>, Vec3<T>),
+        outer_rect: ParamRect<T>,
+        inner: (Vec3<T>, Vec3<T>, Vec3<T>),
+        rect: ParamRect<T>,
+        occluders: &O,
+        bounds: &Ball<T>,
+    ) -> Option<Self> {
+        let (ac, bc) = (map_corners(outer, outer_rect), map_corners(inner, rect));
+        let (_, tolerance) = outer_frame(&ac, &bc);
+        let (casters, n, _) = pair_casters(outer, (&ac, &bc), inner.1.cross(inner.2), occluders, bounds)?;
+        let given = casters;
+        let mut snapped = casters;
+        let snapped = snapped.get_mut(..n).unwrap_or_default();
+        snap_corners(snapped, tolerance);
+        let (labels, solids) = label_solids(snapped, tolerance)?;
+        let mut table = Self::none();
+        for label in 1..=solids {
+            let solid = Solid::of_label(snapped, &labels, label)?;
+            if solid.n_facets < 2 || !solid.convex(&ac, &bc, tolerance) {
+                continue;
+            }
+            let count = T::from_f64(solid.n_vertices.max(1) as f64);
+            let centre = solid.vertices().iter().fold(Vec3::ZERO, |m, &v| m + v).scale(T::ONE / count);
+            for (((corners, k, _), (own, _, _)), _) in
+                snapped.iter().zip(given.iter()).zip(labels.iter()).filter(|(_, &l)| l == label)
+            {
+                let (o, normal) = plane_of(corners.get(..*k)?)?;
+                let outward = if normal.dot(centre - o) > T::ZERO { -normal } else { normal };
+                *table.facets.get_mut(table.n)? = ([*own.first()?, *own.get(1)?, *own.get(2)?], *k, outward);
+                table.n += 1;
+            }
+        }
+        Some(table)
+    }
+
+    /// Whether the polygon `corners` is one of the facets and faces away from p by more than
+    /// rounding.
+    pub(super) fn skips(&self, corners: &[Vec3<T>], p: Vec3<T>) -> bool {
+        let Some(first) = corners.get(..3) else { return false };
+        self.facets.get(..self.n).unwrap_or_default().iter().any(|(c, k, normal)| {
+            *k == corners.len()
+                && c.as_slice() == first
+                && normal.dot(p - c[0]) < -T::GEOMETRY_TOLERANCE * (p - c[0]).norm()
+        })
+    }
 }
 
 /// Moves each corner within `tolerance` of an earlier one (of any polygon) onto it: facets
@@ -606,6 +780,122 @@ fn shadows_apart<T: Real>(x: &Hull<T>, y: &Hull<T>, a: &Hull<T>, b: &Hull<T>, to
         || (apart_from_hull(x, a, y, tolerance) && apart_from_hull(x, b, y, tolerance))
 }
 
+/// A condition on p for an event to be real: g₀·(p − o) ≥ 0, or, with g₁,
+/// (g₀·(p − o))·(g₁·(p − o)) ≥ 0 (a double wedge about a line through o).
+type Condition<T> = (Vec3<T>, Vec3<T>, Option<Vec3<T>>);
+
+/// The condition that the edge v → w of `solid` is on its outline seen from p (p outside one of
+/// its two facets and not the other); none for an edge of one facet.
+fn outline<T: Real>(solid: &Solid<T>, v: Vec3<T>, w: Vec3<T>) -> Option<Condition<T>> {
+    match solid.edge_normals(v, w) {
+        [Some(n1), Some(n2)] => Some((v, n1, Some(-n2))),
+        _ => None,
+    }
+}
+
+/// Where the segments [w0, w1] and [c, d], both in the plane with unit normal `unit`, cross
+/// inside both (their ends excluded: a crossing at an end is a vertex or a corner, whose
+/// events are placed already); `None` where they do not or are parallel.
+fn segments_cross<T: Real>(
+    w0: Vec3<T>,
+    w1: Vec3<T>,
+    c: Vec3<T>,
+    d: Vec3<T>,
+    unit: Vec3<T>,
+    tolerance: T,
+) -> Option<Vec3<T>> {
+    let (r, q) = (w1 - w0, d - c);
+    let denom = r.cross(q).dot(unit);
+    if !(denom.abs() > T::GEOMETRY_TOLERANCE * r.norm() * q.norm()) {
+        return None;
+    }
+    let (t, u) = ((c - w0).cross(q).dot(unit) / denom, (c - w0).cross(r).dot(unit) / denom);
+    let (mt, mu) = (tolerance / r.norm(), tolerance / q.norm());
+    (t > mt && t < T::ONE - mt && u > mu && u < T::ONE - mu).then(|| w0 + r.scale(t))
+}
+
+/// The quadric of the points on a line that meets the three lines through the segments `i`,
+/// `j` and `k` (not as segments): p is on one exactly where the planes through p and each line
+/// share a line, i.e. where their normals dᵢ × (p − i₀), … are linearly dependent. Their
+/// determinant's cubic part det[dᵢ × v, dⱼ × v, dₖ × v] vanishes (three vectors normal to v),
+/// so with v = p − i₀ it is the quadric
+/// det[dᵢ×v, mⱼ, dₖ×v] + det[dᵢ×v, dⱼ×v, mₖ] + det[dᵢ×v, mⱼ, mₖ], mⱼ = dⱼ × (i₀ − j₀),
+/// mₖ = dₖ × (i₀ − k₀), whose coefficients are read off by polarisation. `None` where it
+/// vanishes identically to rounding (three lines in one plane, or through one point: every
+/// line there meets all three, and the events are the planes through a vertex and an edge).
+fn three_lines<T: Real>(
+    (i0, i1): (Vec3<T>, Vec3<T>),
+    (j0, j1): (Vec3<T>, Vec3<T>),
+    (k0, k1): (Vec3<T>, Vec3<T>),
+) -> Option<Quadric<T>> {
+    let (di, dj, dk) = (i1 - i0, j1 - j0, k1 - k0);
+    let (mj, mk) = (dj.cross(i0 - j0), dk.cross(i0 - k0));
+    let det = |a: Vec3<T>, b: Vec3<T>, c: Vec3<T>| a.dot(b.cross(c));
+    let q = |v: Vec3<T>| det(di.cross(v), mj, dk.cross(v)) + det(di.cross(v), dj.cross(v), mk);
+    let l = |v: Vec3<T>| det(di.cross(v), mj, mk);
+    let (o, e) = (T::ZERO, T::ONE);
+    let (ex, ey, ez) = (vec3(e, o, o), vec3(o, e, o), vec3(o, o, e));
+    let (xx, yy, zz) = (q(ex), q(ey), q(ez));
+    let m = [
+        xx,
+        yy,
+        zz,
+        (q(ex + ey) - xx - yy) * T::HALF,
+        (q(ex + ez) - xx - zz) * T::HALF,
+        (q(ey + ez) - yy - zz) * T::HALF,
+    ];
+    let g = vec3(l(ex), l(ey), l(ez));
+    let length = di.norm() + dj.norm() + dk.norm() + (i0 - j0).norm() + (i0 - k0).norm();
+    let size = m.iter().fold(T::ZERO, |s, x| s.max(x.abs())) * length * length + g.norm() * length;
+    let scale = di.norm() * dj.norm() * dk.norm() * length * length * length;
+    (size > T::GEOMETRY_TOLERANCE * scale).then_some(Quadric { origin: i0, m, g, c: T::ZERO, guard: None })
+}
+
+/// Whether no point of a (corners `ac`) lies on a line from a point of the segment `from`
+/// through one of `through`, beyond it: such points are (1 − λ)·x + λ·y with λ ≥ 1, and at
+/// most `reach` (the farthest of a from b) over the segments' distance, so within the hull of
+/// `through` and the four points at that λ, which a separating axis shows apart from a. Axes
+/// are tried from the likeliest (a's normal) on; one missed keeps the event (a break more).
+fn fan_misses<T: Real>(
+    (b0, b1): (Vec3<T>, Vec3<T>),
+    (e0, e1): (Vec3<T>, Vec3<T>),
+    ac: &[Vec3<T>; 4],
+    reach: T,
+    tolerance: T,
+) -> bool {
+    let gap = segment_to_segment(b0, b1, e0, e1);
+    if !(gap > tolerance) {
+        return false;
+    }
+    let lambda = (reach / gap).max(T::ONE);
+    let far = |b: Vec3<T>, e: Vec3<T>| b + (e - b).scale(lambda);
+    let points = [e0, e1, far(b0, e0), far(b0, e1), far(b1, e0), far(b1, e1)];
+    let apart = |axis: Vec3<T>| {
+        let length = axis.norm();
+        if !(length > T::ZERO) {
+            return false;
+        }
+        let range = |ps: &[Vec3<T>]| {
+            ps.iter().fold((T::MAX, -T::MAX), |(lo, hi), &x| (lo.min(axis.dot(x)), hi.max(axis.dot(x))))
+        };
+        let ((p0, p1), (a0, a1)) = (range(&points), range(ac));
+        let slack = tolerance * length;
+        p1 < a0 - slack || a1 < p0 - slack
+    };
+    let (Some(&c0), Some(&c1), Some(&c3)) = (ac.first(), ac.get(1), ac.get(3)) else { return false };
+    let a_edges = [c1 - c0, c3 - c0];
+    if apart(a_edges[0].cross(a_edges[1])) {
+        return true;
+    }
+    let (de, db) = (e1 - e0, b1 - b0);
+    if apart(de.cross(db)) {
+        return true;
+    }
+    let connectors = points.iter().skip(2).flat_map(|&f| [f - e0, f - e1]);
+    let hull_edges = || [de, db].into_iter().chain(connectors.clone());
+    hull_edges().any(|h| hull_edges().chain(a_edges).any(|g| apart(h.cross(g))))
+}
+
 /// The distance from the segment [c0, c1] to the convex polygon (zero where they meet).
 fn segment_to_polygon<T: Real>(c0: Vec3<T>, c1: Vec3<T>, polygon: &[Vec3<T>]) -> T {
     let Some((o, n)) = plane_of(polygon) else { return T::ZERO };
@@ -727,8 +1017,9 @@ impl<T: Real> PolygonEvents<T> {
     /// The events of outer a (affine map `outer` over `outer_rect`) against the parallelogram b
     /// (affine map `inner` over `rect`, inside `bounds`) across `occluders` (module docs);
     /// `None` where an occluder that may cut is neither a flat convex polygon nor one sphere,
-    /// the polygons are not the facets of at most [`MAX_SOLIDS`] convex solids, two solids' (or a
-    /// solid's and the sphere's) shadows may meet on b, a sphere is the only occluder near
+    /// the polygons are not the facets of at most [`MAX_SOLIDS`] convex solids, a solid's and the
+    /// sphere's shadows, or three solids' that each meet the others', may meet on b, a solid
+    /// whose shadow may meet another's reaches behind b's plane, a sphere is the only occluder near
     /// (`Events::new` places it), or the curves overflow [`MAX_POLYGON_EVENT_CURVES`]. Where b
     /// straddles a's plane, the corners and edges are those of its part in front
     /// ([`front_part`]). The lines are kinks between analytic sides, and the
@@ -751,44 +1042,10 @@ impl<T: Real> PolygonEvents<T> {
         // occluders may cut keep the whole of b (more segments: never fewer events).
         let (front, n_front) = front_part(outer, bo, &bc);
         let front = front.get(..n_front).unwrap_or_default();
-        let (from, tolerance) = outer_frame(&ac, &bc);
+        let (_, tolerance) = outer_frame(&ac, &bc);
         let (a_hull, b_hull) = (Hull::of_quad(&ac), Hull::of_quad(&bc));
-        // A polygon on or behind a's plane or b's (their radiating sides) cannot cut a
-        // segment between points of a and b in front of each other: the rest of a box one of
-        // whose facets is a or b.
-        let (na, nb) = (outer.1.cross(outer.2), bt.cross(bs));
-        let behind = |corners: &[Vec3<T>]| {
-            let below = |o: Vec3<T>, n: Vec3<T>| corners.iter().all(|&c| n.dot(c - o) <= tolerance * n.norm());
-            below(outer.0, na) || below(bo, nb)
-        };
-        // Every polygon that may cut, and whether a segment from a to b can cross it; the one
-        // sphere that can.
-        let mut casters = [([Vec3::ZERO; FACET_CORNERS], 0usize, false); MAX_CASTERS];
-        let mut n_casters = 0usize;
-        let mut sphere = None;
-        let mut fits = true;
-        let supported = occluders.shadow_casters(&from, &bc, bounds, &mut |caster| match caster {
-            Caster::Polygon(corners) => match (casters.get_mut(n_casters), corners.len() <= FACET_CORNERS) {
-                (Some(slot), true) => {
-                    for (x, &c) in slot.0.iter_mut().zip(corners) {
-                        *x = c;
-                    }
-                    let crossed = !behind(corners) && !facet_separated(corners, &ac, &bc, tolerance);
-                    *slot = (slot.0, corners.len(), crossed);
-                    n_casters += 1;
-                }
-                _ => fits = false,
-            },
-            Caster::Sphere(ball) => {
-                if !apart_from_hull(&Hull::of_ball(&ball), &a_hull, &b_hull, tolerance) {
-                    fits &= sphere.is_none();
-                    sphere = Some(ball);
-                }
-            }
-        });
-        if !supported || !fits {
-            return None;
-        }
+        let nb = bt.cross(bs);
+        let (mut casters, n_casters, sphere) = pair_casters(outer, (&ac, &bc), nb, occluders, bounds)?;
         let casters = casters.get_mut(..n_casters).unwrap_or_default();
         snap_corners(casters, tolerance);
         let casters = &*casters;
@@ -803,12 +1060,15 @@ impl<T: Real> PolygonEvents<T> {
         let unit_b = nb.scale(T::ONE / nb.norm());
         // Above b's plane by more than rounding: a vertex there has a shadow that moves with p.
         let above_b = |x: Vec3<T>| unit_b.dot(x - bo) > tolerance;
-        // The plane through x spanned by u and w, guarded to their double wedge; none where
-        // they are parallel to rounding (a vertex on b's edge line, an edge through b's corner).
-        let mut wedge_plane = |events: &mut Self, x: Vec3<T>, u: Vec3<T>, w: Vec3<T>| {
+        // The plane through x spanned by u and w, where the ray from p through x meets the
+        // segment between x + u and x + w (their double wedge) and `more` holds; none where u
+        // and w are parallel to rounding (a vertex on b's edge line, an edge through b's
+        // corner).
+        let mut wedge_plane = |events: &mut Self, x: Vec3<T>, u: Vec3<T>, w: Vec3<T>, more: Option<Condition<T>>| {
             let n = u.cross(w);
             if n.norm() > T::GEOMETRY_TOLERANCE * u.norm() * w.norm() {
-                room &= events.push_line(outer, outer_rect, Quadric::plane(x, n).guarded(n.cross(u), w.cross(n)));
+                let conditions = [Some((x, n.cross(u), Some(w.cross(n)))), more];
+                room &= events.push_trimmed(outer, outer_rect, (x, n), &conditions, tolerance);
             }
         };
         let mut planes = true;
@@ -828,12 +1088,14 @@ impl<T: Real> PolygonEvents<T> {
                     let (Some(&c), Some(&d)) = (front.get(k), front.get((k + 1) % front.len())) else {
                         return None;
                     };
-                    wedge_plane(&mut events, v, c - v, d - v);
+                    // Only p above v: the part of a solid beyond p's height casts no shadow.
+                    wedge_plane(&mut events, v, c - v, d - v, Some((v, unit_b, None)));
                 }
             }
             for &(v, w, _) in solid.edges().iter().filter(|e| above_b(e.0) || above_b(e.1)) {
                 for &c in front {
-                    wedge_plane(&mut events, c, v - c, w - c);
+                    // Only where the edge is on the solid's outline seen from p.
+                    wedge_plane(&mut events, c, v - c, w - c, outline(&solid, v, w));
                 }
             }
             for facet in solid.facets() {
@@ -865,16 +1127,239 @@ impl<T: Real> PolygonEvents<T> {
             events.set_grade(near);
             *hulls.get_mut(usize::from(solids))? = Some(Hull::of_ball(&ball));
         }
-        // Two solids (or a solid and the sphere) whose shadows can meet on b would add the
-        // events where they meet.
-        let hulls = hulls.iter().flatten();
-        for (i, x) in hulls.clone().enumerate() {
-            if hulls.clone().skip(i + 1).any(|y| !shadows_apart(x, y, &a_hull, &b_hull, tolerance)) {
-                return None;
+        // Two solids whose shadows can meet on b add the events where they meet; a solid's and
+        // the sphere's, or three solids' that can all meet one another, are declined.
+        let mut meets = [[false; MAX_SOLIDS + 1]; MAX_SOLIDS + 1];
+        for (i, x) in hulls.iter().enumerate() {
+            for (j, y) in hulls.iter().enumerate().skip(i + 1) {
+                if let (Some(x), Some(y)) = (x, y) {
+                    let meet = !shadows_apart(x, y, &a_hull, &b_hull, tolerance);
+                    *meets.get_mut(i)?.get_mut(j)? = meet;
+                    *meets.get_mut(j)?.get_mut(i)? = meet;
+                }
+            }
+        }
+        let count = usize::from(solids);
+        for (i, row) in meets.iter().enumerate() {
+            for j in (i + 1)..=MAX_SOLIDS {
+                if !row.get(j).copied().unwrap_or(false) {
+                    continue;
+                }
+                if i >= count || j >= count {
+                    return None;
+                }
+                if (0..=MAX_SOLIDS)
+                    .any(|k| row.get(k) == Some(&true) && meets.get(j).and_then(|r| r.get(k)) == Some(&true))
+                {
+                    return None;
+                }
+                let x = Solid::of_label(casters, &labels, u8::try_from(i + 1).ok()?)?;
+                let y = Solid::of_label(casters, &labels, u8::try_from(j + 1).ok()?)?;
+                room &= events.push_meeting(outer, outer_rect, (&x, &y), front, (bo, unit_b), &ac, tolerance)?;
             }
         }
         planes &= events.push_line(outer, outer_rect, Quadric::plane(bo, unit_b));
         (room && planes).then_some(events)
+    }
+
+    /// The events where the shadows of two convex solids `x` and `y` meet on b's visible part
+    /// (corners `front`; b's plane through `origin` with unit normal `unit`), each solid's own
+    /// being placed already. Their shadows' union changes structure where
+    ///
+    /// * a vertex of one's shadow crosses an edge of the other's: p in the plane through a
+    ///   vertex v of one solid and an edge of the other, guarded to the double wedge about v
+    ///   that the edge spans (the ray from p through v meets the edge);
+    /// * an edge of one's shadow crosses a corner of the other's clipped by b: p in the plane
+    ///   through the fixed point where an edge of one solid lying in b's plane crosses an edge
+    ///   of b, and an edge of the other;
+    /// * two shadow edges cross on an edge of b: p on a line meeting an edge of each solid and
+    ///   an edge of b ([`three_lines`], a quadric), guarded to where that line meets b's edge
+    ///   within its segment, and left out where the fans from b's edge through either solid's
+    ///   edge miss a ([`fan_misses`]).
+    ///
+    /// The overlap of the two shadows grows like δ² on one side of each, as a corner's does.
+    /// `None` where a vertex lies behind b's plane (the solid's part in front has vertices
+    /// of its own there); else whether all fitted.
+    #[allow(clippy::too_many_arguments)]
+    fn push_meeting(
+        &mut self,
+        outer: (Vec3<T>, Vec3<T>, Vec3<T>),
+        outer_rect: ParamRect<T>,
+        (x, y): (&Solid<T>, &Solid<T>),
+        front: &[Vec3<T>],
+        (origin, unit): (Vec3<T>, Vec3<T>),
+        ac: &[Vec3<T>; 4],
+        tolerance: T,
+    ) -> Option<bool> {
+        let height = |v: Vec3<T>| unit.dot(v - origin);
+        if x.vertices().iter().chain(y.vertices()).any(|&v| height(v) < -tolerance) {
+            return None;
+        }
+        let above = |v: Vec3<T>| height(v) > tolerance;
+        let moving = |e: &&(Vec3<T>, Vec3<T>, u8)| above(e.0) || above(e.1);
+        let centre =
+            front.iter().fold(Vec3::ZERO, |m, &c| m + c).scale(T::ONE / T::from_f64(front.len().max(1) as f64));
+        let inside_front = |q: Vec3<T>| {
+            polygon_sides(front).all(|(c, d)| {
+                (d - c).cross(q - c).dot(unit) * (d - c).cross(centre - c).dot(unit) >= -tolerance * tolerance
+            })
+        };
+        let mut room = true;
+        for (one, other) in [(x, y), (y, x)] {
+            for &v in one.vertices() {
+                if !above(v) && !inside_front(v) {
+                    continue;
+                }
+                for &(w0, w1, _) in other.edges().iter().filter(|e| above(v) || moving(e)) {
+                    let (u, w) = (w0 - v, w1 - v);
+                    let n = u.cross(w);
+                    let mut conditions = [None; 8];
+                    conditions[0] = Some((v, n.cross(u), Some(w.cross(n))));
+                    conditions[1] = outline(other, w0, w1);
+                    if above(v) {
+                        // p above v, and the ray from p through v landing in b's visible part.
+                        conditions[2] = Some((v, unit, None));
+                        for ((c, d), slot) in polygon_sides(front).zip(conditions.iter_mut().skip(3)) {
+                            let m = (c - v).cross(d - v);
+                            let side = m.dot(v - centre);
+                            if side != T::ZERO {
+                                *slot = Some((v, if side > T::ZERO { m } else { -m }, None));
+                            }
+                        }
+                    }
+                    room &= self.push_trimmed(outer, outer_rect, (v, n), &conditions, tolerance);
+                }
+            }
+            for &(w0, w1, _) in one.edges().iter().filter(|e| !moving(e)) {
+                for (c, d) in polygon_sides(front) {
+                    let Some(cross) = segments_cross(w0, w1, c, d, unit, tolerance) else { continue };
+                    for &(e0, e1, _) in other.edges().iter().filter(moving) {
+                        let (u, w) = (e0 - cross, e1 - cross);
+                        let n = u.cross(w);
+                        let mut conditions = [None; 8];
+                        conditions[0] = Some((cross, n.cross(u), Some(w.cross(n))));
+                        conditions[1] = outline(other, e0, e1);
+                        room &= self.push_trimmed(outer, outer_rect, (cross, n), &conditions, tolerance);
+                    }
+                }
+            }
+        }
+        let reach = ac.iter().flat_map(|&p| front.iter().map(move |&c| (p - c).norm())).fold(T::ZERO, T::max);
+        for &(i0, i1, _) in x.edges().iter().filter(moving) {
+            for &(j0, j1, _) in y.edges().iter().filter(moving) {
+                for (b0, b1) in polygon_sides(front) {
+                    if fan_misses((b0, b1), (i0, i1), ac, reach, tolerance)
+                        || fan_misses((b0, b1), (j0, j1), ac, reach, tolerance)
+                    {
+                        continue;
+                    }
+                    let Some(quadric) = three_lines((i0, i1), (j0, j1), (b0, b1)) else { continue };
+                    let di = i1 - i0;
+                    room &= self.push_quadric(outer, quadric.guarded(di.cross(b0 - i0), -di.cross(b1 - i0)));
+                }
+            }
+        }
+        Some(room)
+    }
+
+    /// Keeps the plane through `x` with normal `normal` as a line in a's parameters, only on
+    /// the part of it (within a widened by half its size on each side) where every one of
+    /// `conditions` holds, or the hull of that part where a condition leaves two; nothing
+    /// where that part is empty or the plane is parallel to a. `false` on overflow.
+    fn push_trimmed(
+        &mut self,
+        outer: (Vec3<T>, Vec3<T>, Vec3<T>),
+        r: ParamRect<T>,
+        (x, normal): (Vec3<T>, Vec3<T>),
+        conditions: &[Option<Condition<T>>],
+        tolerance: T,
+    ) -> bool {
+        let (oa, et, es) = outer;
+        let (a, b, c) = (normal.dot(et), normal.dot(es), normal.dot(oa - x));
+        let (dt, ds) = ((r.t1 - r.t0).abs(), (r.s1 - r.s0).abs());
+        let reach = normal.norm() * (et.norm() * dt + es.norm() * ds);
+        if !((a * dt).abs() + (b * ds).abs() > reach * T::GEOMETRY_TOLERANCE) {
+            return true;
+        }
+        // The line (t, s) = p₀ + λ·(−b, a), clipped to a widened by half on each side.
+        let n2 = a * a + b * b;
+        let (t0, s0, vt, vs) = (-c * a / n2, -c * b / n2, -b, a);
+        let (mut lo, mut hi) = (-T::MAX, T::MAX);
+        for (p, d, min, max) in [
+            (t0, vt, r.t0.min(r.t1) - dt * T::HALF, r.t0.max(r.t1) + dt * T::HALF),
+            (s0, vs, r.s0.min(r.s1) - ds * T::HALF, r.s0.max(r.s1) + ds * T::HALF),
+        ] {
+            if d == T::ZERO {
+                if p < min || p > max {
+                    return true;
+                }
+            } else {
+                let (u, w) = ((min - p) / d, (max - p) / d);
+                lo = lo.max(u.min(w));
+                hi = hi.min(u.max(w));
+            }
+        }
+        let (p0, dp) = (oa + et.scale(t0) + es.scale(s0), et.scale(vt) + es.scale(vs));
+        // Each factor g·(p − o) = α + β·λ along the line; the root, widened by the tolerance.
+        let factor = |o: Vec3<T>, g: Vec3<T>| (g.dot(p0 - o), g.dot(dp), tolerance * g.norm());
+        for &(o, g0, g1) in conditions.iter().flatten() {
+            let (a0, b0, m0) = factor(o, g0);
+            match g1 {
+                None => {
+                    if b0 > T::ZERO {
+                        lo = lo.max((-m0 - a0) / b0);
+                    } else if b0 < T::ZERO {
+                        hi = hi.min((-m0 - a0) / b0);
+                    } else if a0 < -m0 {
+                        return true;
+                    }
+                }
+                Some(g1) => {
+                    let (a1, b1, m1) = factor(o, g1);
+                    if b0 == T::ZERO || b1 == T::ZERO {
+                        // One factor constant: the other's sign alone, or no condition.
+                        let ((ac, mc), (av, bv, mv)) =
+                            if b0 == T::ZERO { ((a0, m0), (a1, b1, m1)) } else { ((a1, m1), (a0, b0, m0)) };
+                        if ac.abs() <= mc || bv == T::ZERO {
+                            if bv == T::ZERO && ac * av < -(mc * mv) && ac.abs() > mc && av.abs() > mv {
+                                return true;
+                            }
+                            continue;
+                        }
+                        let (av, bv) = if ac > T::ZERO { (av, bv) } else { (-av, -bv) };
+                        if bv > T::ZERO {
+                            lo = lo.max((-mv - av) / bv);
+                        } else {
+                            hi = hi.min((-mv - av) / bv);
+                        }
+                        continue;
+                    }
+                    let (r0, r1) = (-a0 / b0, -a1 / b1);
+                    let widen = m0 / b0.abs() + m1 / b1.abs();
+                    let (first, last) = (r0.min(r1), r0.max(r1));
+                    if b0 * b1 < T::ZERO {
+                        // Same sign only between the roots.
+                        lo = lo.max(first - widen);
+                        hi = hi.min(last + widen);
+                    } else if first + widen < last - widen {
+                        // Same sign only outside the roots: [lo, hi] less the gap between.
+                        let (gap0, gap1) = (first + widen, last - widen);
+                        if lo >= gap0 && hi <= gap1 {
+                            return true;
+                        } else if lo >= gap0 {
+                            lo = lo.max(gap1);
+                        } else if hi <= gap1 {
+                            hi = hi.min(gap0);
+                        }
+                    }
+                }
+            }
+            if lo > hi {
+                return true;
+            }
+        }
+        let (from, to) = ((t0 + lo * vt, s0 + lo * vs), (t0 + hi * vt, s0 + hi * vs));
+        self.push_segment([a, b, c], [vt, vs, -(vt * from.0 + vs * from.1)], [-vt, -vs, vt * to.0 + vs * to.1])
     }
 
     /// Keeps the plane `quadric` (guarded or not) as a line in a's parameters; `false` on

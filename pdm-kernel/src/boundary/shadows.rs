@@ -64,9 +64,18 @@ impl<T: Real> Piece<T> {
     /// The part of the piece where `side` ≥ 0 (`keep_positive`) or ≤ 0 (Sutherland–Hodgman
     /// against one line); `None` if it overflows [`PIECE_VERTICES`].
     fn clip(&self, side: Side<T>, keep_positive: bool) -> Option<Self> {
+        let mut out = Piece { vertices: [(T::ZERO, T::ZERO); PIECE_VERTICES], count: 0, next: self.next };
+        self.clip_into(side, keep_positive, &mut out)?;
+        Some(out)
+    }
+
+    /// [`Self::clip`] written into `out` (its vertices overwritten, `next` taken from `self`),
+    /// which saves the copies of a returned piece in the loop over a shadow's sides.
+    fn clip_into(&self, side: Side<T>, keep_positive: bool, out: &mut Self) -> Option<()> {
         let sign = if keep_positive { T::ONE } else { -T::ONE };
         let value = |(t, s): (T, T)| sign * (side[0] * t + side[1] * s + side[2]);
-        let mut out = Piece { vertices: [(T::ZERO, T::ZERO); PIECE_VERTICES], count: 0, next: self.next };
+        out.count = 0;
+        out.next = self.next;
         let verts = self.vertices();
         for (k, &v) in verts.iter().enumerate() {
             let w = *verts.get((k + 1) % verts.len())?;
@@ -81,7 +90,7 @@ impl<T: Real> Piece<T> {
                 out.count += 1;
             }
         }
-        Some(out)
+        Some(())
     }
 
     /// Whether the whole piece lies on the non-positive side of `side`, to rounding.
@@ -154,6 +163,11 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
                         return;
                     }
                 };
+                // A facet of a convex solid facing away from p: the facets facing p hide
+                // everything it does.
+                if self.back_facets.skips(corners, p) {
+                    return;
+                }
                 match shadow_of(corners, p, hp, nq, o, et, es, flat) {
                     // A shadow that misses the part of b in front of p takes no slot.
                     Some(Some(shadow))
@@ -232,14 +246,25 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
                 continue;
             };
             // The piece less the shadow: outside side 1, then inside 1 and outside 2, ...
-            let mut rest = Piece { next: piece.next + 1, ..piece };
+            let (mut first, mut second) = (Piece { next: piece.next + 1, ..piece }, piece);
+            let (mut rest, mut spare) = (&mut first, &mut second);
             for &side in shadow.sides.get(..shadow.count).unwrap_or_default() {
-                let outside = rest.clip(side, false)?;
-                if outside.count >= 3 {
-                    *stack.get_mut(pending)? = outside;
+                // The part outside this side waits on the stack (a full stack: a piece of
+                // its own, which must then be empty).
+                let mut overflow = piece;
+                let slot = match stack.get_mut(pending) {
+                    Some(slot) => slot,
+                    None => &mut overflow,
+                };
+                rest.clip_into(side, false, slot)?;
+                if slot.count >= 3 {
+                    if pending >= MAX_PIECES {
+                        return None;
+                    }
                     pending += 1;
                 }
-                rest = rest.clip(side, true)?;
+                rest.clip_into(side, true, spare)?;
+                core::mem::swap(&mut rest, &mut spare);
                 if rest.count < 3 {
                     break;
                 }
