@@ -172,8 +172,10 @@ where
     O: Occluder<T> + ?Sized,
 {
     // With the outer events placed into the rule the pair converges exponentially in the
-    // order, like a smooth pair: orders 4, 6, … compared as such, the larger patch halved at
-    // `max_order`.
+    // order, like a smooth pair: orders 2, 4, 6, … compared as such (three at least), the
+    // larger patch halved at `max_order`. Order 2 is the start: with many events the pieces
+    // are small and the low orders already close (two shadows that meet: ~300 curves, and
+    // order 4 within 1e-10), and where they are not, its step only adds a cheap evaluation.
     #[cfg(feature = "closed-form")]
     match crate::pair::occluded_outer(a, b, occluders, false) {
         (true, outer_b) => {
