@@ -132,6 +132,9 @@ pub(super) struct Events<T, const N: usize, const SB: usize, const TB: usize> {
     /// The sides of `limit` (t₀, t₁, s₀, s₁) towards which the rule is graded: an occluder
     /// touches the outer patch there, and J is singular along that side.
     graded_sides: [bool; 4],
+    /// An occluder touches the outer patch inside it (a box standing on it): J is singular
+    /// along the contact's outline.
+    touched_inside: bool,
 }
 
 /// The events of an occluder that gives its quadrics (a sphere), or of a curved inner patch.
@@ -146,7 +149,13 @@ impl<T: Real, const N: usize, const SB: usize, const TB: usize> Events<T, N, SB,
             grade,
             limit,
             graded_sides: [false; 4],
+            touched_inside: false,
         }
+    }
+
+    /// Records that an occluder touches the outer patch inside it ([`Self::touches_side`]).
+    pub(super) fn touch_inside(&mut self) {
+        self.touched_inside = true;
     }
 
     /// Grades the rule towards side `k` (t₀, t₁, s₀, s₁) of the limit rectangle.
@@ -156,10 +165,11 @@ impl<T: Real, const N: usize, const SB: usize, const TB: usize> Events<T, N, SB,
         }
     }
 
-    /// Whether an occluder touches a side of the outer patch ([`Self::grade_side`]): J is then
-    /// singular there, and the rule converges only algebraically with the order.
+    /// Whether an occluder touches a side of the outer patch ([`Self::grade_side`]) or its
+    /// inside ([`Self::touch_inside`]): J is then singular there, and the rule converges only
+    /// algebraically with the order.
     pub(super) fn touches_side(&self) -> bool {
-        self.graded_sides.iter().any(|&g| g)
+        self.touched_inside || self.graded_sides.iter().any(|&g| g)
     }
 
     /// Whether the rule is graded at `x` on the side `k` of the limit rectangle.
@@ -256,16 +266,20 @@ impl<T: Real, const N: usize, const SB: usize, const TB: usize> Events<T, N, SB,
     pub(super) fn push_quadric(&mut self, outer: (Vec3<T>, Vec3<T>, Vec3<T>), q: Quadric<T>) -> bool {
         let (o, et, es) = outer;
         let v0 = o - q.origin;
-        let conic = [
-            q.bilinear(et, et),
-            T::TWO * q.bilinear(et, es),
-            q.bilinear(es, es),
-            T::TWO * q.bilinear(v0, et) + q.g.dot(et),
-            T::TWO * q.bilinear(v0, es) + q.g.dot(es),
-            q.bilinear(v0, v0) + q.g.dot(v0) + q.c,
-        ];
         let guard = q.guard.map(|gs| gs.map(|g| scaled([g.dot(et), g.dot(es), g.dot(v0)])));
-        self.push(conic, guard)
+        self.push(conic_of(outer, &q), guard)
+    }
+
+    /// Keeps the quadric `q` (its own guard ignored) restricted to a as [`Self::push_quadric`],
+    /// an event only where the line `guard` (in a's parameters) is non-negative; `false` on
+    /// overflow.
+    pub(super) fn push_quadric_within(
+        &mut self,
+        outer: (Vec3<T>, Vec3<T>, Vec3<T>),
+        q: Quadric<T>,
+        guard: Line2<T>,
+    ) -> bool {
+        self.push(conic_of(outer, &q), Some([scaled(guard), [T::ZERO, T::ZERO, T::ONE]]))
     }
 
     /// Keeps the line `line` (L(t, s) = a·t + b·s + c) as an event only between the guard
@@ -417,6 +431,20 @@ impl<T: Real, const N: usize, const SB: usize, const TB: usize> Events<T, N, SB,
         let (lo, hi) = self.limit.map_or((-T::MAX, T::MAX), |l| (l.t0, l.t1));
         graded_sum(breaks.get_mut(..n).unwrap_or_default(), r.t0, r.t1, (lo, hi), rule, &mut |t| f(t, s))
     }
+}
+
+/// The quadric `q` restricted to a (affine map `outer`): with p = o + t·e_t + s·e_s and
+/// v₀ = o − origin, F = (v₀ + t·e_t + s·e_s)ᵀ M (…) + g·(…) + c, a conic in (t, s).
+fn conic_of<T: Real>((o, et, es): (Vec3<T>, Vec3<T>, Vec3<T>), q: &Quadric<T>) -> Conic<T> {
+    let v0 = o - q.origin;
+    [
+        q.bilinear(et, et),
+        T::TWO * q.bilinear(et, es),
+        q.bilinear(es, es),
+        T::TWO * q.bilinear(v0, et) + q.g.dot(et),
+        T::TWO * q.bilinear(v0, es) + q.g.dot(es),
+        q.bilinear(v0, v0) + q.g.dot(v0) + q.c,
+    ]
 }
 
 /// The coefficients scaled to the largest 1 (unchanged if all are zero).

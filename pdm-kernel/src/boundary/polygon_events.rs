@@ -36,16 +36,17 @@
 //! of b (p on a line meeting three lines: a quadric), which `push_meeting` adds. Each event
 //! is kept only on the part of a where it can be real (`push_trimmed`: the ray through the
 //! vertex lands on the edge and in b, the edge is on its solid's outline seen from p; a
-//! quadric where its line meets b's edge segment and the fans through both solids' edges
-//! reach a). A sphere's shadow that can meet a solid's, or three solids' that can all meet,
+//! quadric on the arc, sampled along b's edge, where its line meets both solids' edges between
+//! p and b, both on their outlines: `real_arc`; most of the 576 candidates of two boxes are
+//! real nowhere on a, and the rest on short arcs). A sphere's shadow that can meet a solid's, or three solids' that can all meet,
 //! bring curves of other kinds: those pairs are declined (`None`), and the outer rule samples
 //! across their events as before.
 //!
 //! The outer rule is a tensor product: every curve's ends and crossings of a's t-edges are
 //! breaks along the whole of s, so n curves cost O(n²) pieces. Two boxes whose shadows meet
-//! give a few hundred curves and ~10⁵ outer points at order 4, where the value is exact to
-//! 1e-10; sampling across them instead is cheap per order but converges algebraically (the
-//! floor–ceiling pair above: 3.8e-4 off at order 8, 2.7e-5 at order 24).
+//! give one to two hundred curves and ~5·10⁴ outer points at order 4, where the value is
+//! exact to 1e-10; sampling across them instead is cheap per order but converges
+//! algebraically (a floor and a ceiling past two boxes: 4.6e-4 off at order 8, 2.4e-5 at 24).
 //!
 //! Occluders that cannot cut any segment from a to b (a separating plane between the occluder
 //! and the hull of a and b, or lying on or behind a's or b's plane) are left out first, so a
@@ -65,8 +66,7 @@ use crate::visibility::{Caster, Quadric};
 /// Most event curves of one pair across polygons. One box gives at most 86 lines (its eight
 /// vertices against b's four edges, its twelve edges against b's four corners, its six facet
 /// planes) before those that miss a are left out; two boxes whose shadows meet add up to 192
-/// vertex–edge planes and 576 three-line quadrics, of which a few hundred meet a (a floor and
-/// a ceiling 3 apart past a box on the floor and one above it: 266 curves in all). A pair
+/// vertex–edge planes and 576 three-line quadrics, most of them real nowhere on a. A pair
 /// whose curves overflow is declined: the outer rule samples across its events.
 pub(crate) const MAX_POLYGON_EVENT_CURVES: usize = 384;
 
@@ -422,6 +422,10 @@ fn pair_casters<T: Real, O: Occluder<T> + ?Sized>(
     (supported && fits).then_some((casters, n_casters, sphere))
 }
 
+/// One entry of [`BackFacets`]: a facet's first three corners, their number, its unit outward
+/// normal, its solid.
+type BackFacet<T> = ([Vec3<T>; 3], usize, Vec3<T>, u8);
+
 /// Most facets J may skip ([`BackFacets`]).
 const MAX_BACK_FACETS: usize = MAX_CASTERS;
 
@@ -430,18 +434,20 @@ const MAX_BACK_FACETS: usize = MAX_CASTERS;
 /// hides nothing the facets facing p do not (a segment from p leaving the solid through it
 /// entered through a facet facing p, or through a part of the solid no facet covers, which
 /// `Solid::convex` proves no segment from a to b crosses), so J(p) may leave its shadow out
-/// (`Inner::point_past_polygons`). Each entry: the facet's first three corners as the
+/// (`Inner::point_past_polygons`). Only from p outside the solid: p on its surface (a point of
+/// a floor under a box standing on it) is behind every facet but the one it lies in, and
+/// the solid hides everything from it. Each entry: the facet's first three corners as the
 /// occluder gives them and their number (to recognise it: facets of a box share corners, no
-/// two share three), its unit outward normal.
+/// two share three), its unit outward normal, and its solid.
 pub(super) struct BackFacets<T> {
-    facets: [([Vec3<T>; 3], usize, Vec3<T>); MAX_BACK_FACETS],
+    facets: [BackFacet<T>; MAX_BACK_FACETS],
     n: usize,
 }
 
 impl<T: Real> BackFacets<T> {
     /// No facet skipped.
     pub(super) fn none() -> Self {
-        Self { facets: [([Vec3::ZERO; 3], 0, Vec3::ZERO); MAX_BACK_FACETS], n: 0 }
+        Self { facets: [([Vec3::ZERO; 3], 0, Vec3::ZERO, 0); MAX_BACK_FACETS], n: 0 }
     }
 
     /// The facets of the convex solids among the occluders that may cut between the flat a
@@ -485,21 +491,29 @@ impl<T: Real> BackFacets<T> {
             {
                 let (o, normal) = plane_of(corners.get(..*k)?)?;
                 let outward = if normal.dot(centre - o) > T::ZERO { -normal } else { normal };
-                *table.facets.get_mut(table.n)? = ([*own.first()?, *own.get(1)?, *own.get(2)?], *k, outward);
+                *table.facets.get_mut(table.n)? = ([*own.first()?, *own.get(1)?, *own.get(2)?], *k, outward, label);
                 table.n += 1;
             }
         }
         Some(table)
     }
 
-    /// Whether the polygon `corners` is one of the facets and faces away from p by more than
+    /// Whether the polygon `corners` is one of the facets, faces away from p by more than
+    /// rounding, and p lies outside its solid (in front of one of its facets) by more than
     /// rounding.
     pub(super) fn skips(&self, corners: &[Vec3<T>], p: Vec3<T>) -> bool {
         let Some(first) = corners.get(..3) else { return false };
-        self.facets.get(..self.n).unwrap_or_default().iter().any(|(c, k, normal)| {
+        let facets = self.facets.get(..self.n).unwrap_or_default();
+        let height = |c: &[Vec3<T>; 3], normal: Vec3<T>| {
+            let h = normal.dot(p - c[0]);
+            let margin = T::GEOMETRY_TOLERANCE * (p - c[0]).norm();
+            (h < -margin, h > margin)
+        };
+        facets.iter().any(|(c, k, normal, solid)| {
             *k == corners.len()
                 && c.as_slice() == first
-                && normal.dot(p - c[0]) < -T::GEOMETRY_TOLERANCE * (p - c[0]).norm()
+                && height(c, *normal).0
+                && facets.iter().any(|(d, _, m, own)| own == solid && height(d, *m).1)
         })
     }
 }
@@ -793,6 +807,22 @@ fn outline<T: Real>(solid: &Solid<T>, v: Vec3<T>, w: Vec3<T>) -> Option<Conditio
     }
 }
 
+/// Whether x lies on the flat patch (affine map `outer` over `rect`) to within `tolerance`
+/// of its plane, its parameters inside the rectangle.
+fn on_patch<T: Real>((o, et, es): (Vec3<T>, Vec3<T>, Vec3<T>), rect: ParamRect<T>, x: Vec3<T>, tolerance: T) -> bool {
+    let n = et.cross(es);
+    let length = n.norm();
+    if !(length > T::ZERO) || !(n.dot(x - o).abs() <= tolerance * length) {
+        return false;
+    }
+    let (g11, g12, g22) = (et.dot(et), et.dot(es), es.dot(es));
+    let w = x - o;
+    let (bt, bs) = (et.dot(w), es.dot(w));
+    let det = g11 * g22 - g12 * g12;
+    let (t, s) = ((g22 * bt - g12 * bs) / det, (g11 * bs - g12 * bt) / det);
+    t >= rect.t0.min(rect.t1) && t <= rect.t0.max(rect.t1) && s >= rect.s0.min(rect.s1) && s <= rect.s0.max(rect.s1)
+}
+
 /// Where the segments [w0, w1] and [c, d], both in the plane with unit normal `unit`, cross
 /// inside both (their ends excluded: a crossing at an end is a vertex or a corner, whose
 /// events are placed already); `None` where they do not or are parallel.
@@ -812,6 +842,136 @@ fn segments_cross<T: Real>(
     let (t, u) = ((c - w0).cross(q).dot(unit) / denom, (c - w0).cross(r).dot(unit) / denom);
     let (mt, mu) = (tolerance / r.norm(), tolerance / q.norm());
     (t > mt && t < T::ONE - mt && u > mu && u < T::ONE - mu).then(|| w0 + r.scale(t))
+}
+
+/// A segment by its two ends.
+type Segment<T> = (Vec3<T>, Vec3<T>);
+
+/// Samples along b's edge where [`real_arc`] looks for the part of a three-line quadric that
+/// is an event.
+const ARC_SAMPLES: usize = 48;
+
+/// Where on a a three-line quadric ([`three_lines`]) is an event.
+enum Arc<T> {
+    /// Nowhere on the samples.
+    Never,
+    /// Where this line in a's parameters is non-negative.
+    Within([T; 3]),
+    /// Anywhere it can be (the samples could not bound it).
+    Whole,
+}
+
+/// The part of the quadric of lines meeting the segments `i`, `j` (edges of two solids, on
+/// their outlines where `outlines` hold) and `k` (an edge of b) that is an event on a (affine
+/// map `outer` over `rect`, widened by half on each side): each point x of k has one line
+/// through it meeting the lines of i and j, which meets a's plane in one point p(x), so the
+/// conic on a is p over k's line. Along k, at [`ARC_SAMPLES`] points, the sample is real
+/// where the line meets i and j inside the segments, between p and x, p lies on the widened
+/// a, and both edges are on their solids' outlines seen from p. `Never` where no sample is;
+/// else the chord through the ends of the real samples (widened by a step on each side,
+/// where the conic's arc between them lies on the side of the middle sample), or `Whole`
+/// where that chord is degenerate or the arc passes through infinity. A part shorter than a
+/// step can be missed: its event is then not placed, which costs convergence there, never a
+/// bound (the tolerance mode's orders show it).
+fn real_arc<T: Real>(
+    outer: (Vec3<T>, Vec3<T>, Vec3<T>),
+    rect: ParamRect<T>,
+    ((i0, i1), (j0, j1), (k0, k1)): (Segment<T>, Segment<T>, Segment<T>),
+    (outline_i, outline_j): (Option<Condition<T>>, Option<Condition<T>>),
+    tolerance: T,
+) -> Arc<T> {
+    let (o, et, es) = outer;
+    let na = et.cross(es);
+    let (di, dj, dk) = (i1 - i0, j1 - j0, k1 - k0);
+    let (g11, g12, g22) = (et.dot(et), et.dot(es), es.dot(es));
+    let det = g11 * g22 - g12 * g12;
+    if !(det > T::ZERO) {
+        return Arc::Whole;
+    }
+    let (dt, ds) = ((rect.t1 - rect.t0).abs(), (rect.s1 - rect.s0).abs());
+    let (tlo, thi) = (rect.t0.min(rect.t1) - dt * T::HALF, rect.t0.max(rect.t1) + dt * T::HALF);
+    let (slo, shi) = (rect.s0.min(rect.s1) - ds * T::HALF, rect.s0.max(rect.s1) + ds * T::HALF);
+    let holds = |c: Option<Condition<T>>, p: Vec3<T>| {
+        c.is_none_or(|(co, g0, g1)| {
+            let (f0, f1) = (g0.dot(p - co), g1.map_or(T::ONE, |g| g.dot(p - co)));
+            f0 * f1 >= -(tolerance * tolerance) * g0.norm() * g1.map_or(T::ONE, |g| g.norm())
+        })
+    };
+    // The sample at u along k: p's parameters (t, s), whether it is real, and the side of a's
+    // plane the line runs towards from x; `None` where the line is undefined or parallel to
+    // a's plane.
+    let sample = |u: T| -> Option<((T, T), bool, bool)> {
+        let x = k0 + dk.scale(u);
+        let (ni, nj) = (di.cross(x - i0), dj.cross(x - j0));
+        let dir = ni.cross(nj);
+        let along = na.dot(dir);
+        if !(along.abs() > T::GEOMETRY_TOLERANCE * na.norm() * dir.norm()) {
+            return None;
+        }
+        let lambda = na.dot(o - x) / along;
+        let p = x + dir.scale(lambda);
+        let w = p - o;
+        let (bt, bs) = (et.dot(w), es.dot(w));
+        let (t, s) = ((g22 * bt - g12 * bs) / det, (g11 * bs - g12 * bt) / det);
+        // Where the line meets segment (e0, d): its parameter along the segment and along the line.
+        let hit = |e0: Vec3<T>, d: Vec3<T>| {
+            let c = d.cross(dir);
+            let cc = c.norm2();
+            (cc > T::ZERO).then(|| ((x - e0).cross(dir).dot(c) / cc, (x - e0).cross(d).dot(c) / cc))
+        };
+        let between = |h: Option<(T, T)>| {
+            h.is_some_and(|(nu, mu)| {
+                let m = T::GEOMETRY_TOLERANCE.sqrt();
+                nu >= -m && nu <= T::ONE + m && mu * lambda >= T::ZERO && mu.abs() <= lambda.abs()
+            })
+        };
+        let real = between(hit(i0, di))
+            && between(hit(j0, dj))
+            && t >= tlo
+            && t <= thi
+            && s >= slo
+            && s <= shi
+            && holds(outline_i, p)
+            && holds(outline_j, p);
+        (t.is_finite() && s.is_finite()).then_some(((t, s), real, along > T::ZERO))
+    };
+    let step = T::ONE / T::from_usize(ARC_SAMPLES - 1);
+    let at = |m: T| sample(m * step);
+    let (mut first, mut last) = (None, None);
+    for m in 0..ARC_SAMPLES {
+        match at(T::from_usize(m)) {
+            Some((_, true, _)) => {
+                first = first.or(Some(m));
+                last = Some(m);
+            }
+            Some(_) => {}
+            None => return Arc::Whole,
+        }
+    }
+    let (Some(first), Some(last)) = (first, last) else { return Arc::Never };
+    // The arc from a step before the first real sample to a step past the last, through the
+    // one halfway; where the line turns to the other side of a's plane on it, p passes
+    // through infinity and no chord bounds it.
+    let (lo, hi) = (T::from_usize(first) - T::ONE, T::from_usize(last) + T::ONE);
+    let (Some((a, _, towards)), Some((b, _, _)), Some((middle, _, _))) = (at(lo), at(hi), at((lo + hi) * T::HALF))
+    else {
+        return Arc::Whole;
+    };
+    for m in first.saturating_sub(1)..=(last + 1) {
+        if at(T::from_usize(m)).is_none_or(|(_, _, side)| side != towards) {
+            return Arc::Whole;
+        }
+    }
+    let (vt, vs) = (b.0 - a.0, b.1 - a.1);
+    let side = |(t, s): (T, T)| vt * (s - a.1) - vs * (t - a.0);
+    let size = (vt * vt + vs * vs).sqrt();
+    let bulge = side(middle);
+    if !(size > T::ZERO) || !(bulge.abs() > T::GEOMETRY_TOLERANCE * size * (dt + ds)) {
+        return Arc::Whole;
+    }
+    let sign = if bulge > T::ZERO { T::ONE } else { -T::ONE };
+    // side(t, s) = vt·s − vs·t − (vt·a.1 − vs·a.0), non-negative on the middle's side.
+    Arc::Within([-vs * sign, vt * sign, (vs * a.0 - vt * a.1) * sign])
 }
 
 /// The quadric of the points on a line that meets the three lines through the segments `i`,
@@ -1098,6 +1258,11 @@ impl<T: Real> PolygonEvents<T> {
                     wedge_plane(&mut events, c, v - c, w - c, outline(&solid, v, w));
                 }
             }
+            // A vertex on a's plane inside a (a box standing on the floor a): J is singular
+            // along the box's footprint, as along a side a facet stands on.
+            if solid.vertices().iter().any(|&v| on_patch(outer, outer_rect, v, tolerance)) {
+                events.touch_inside();
+            }
             for facet in solid.facets() {
                 let (origin, normal) = plane_of(facet)?;
                 planes &= events.push_line(outer, outer_rect, Quadric::plane(origin, normal));
@@ -1173,9 +1338,10 @@ impl<T: Real> PolygonEvents<T> {
     ///   through the fixed point where an edge of one solid lying in b's plane crosses an edge
     ///   of b, and an edge of the other;
     /// * two shadow edges cross on an edge of b: p on a line meeting an edge of each solid and
-    ///   an edge of b ([`three_lines`], a quadric), guarded to where that line meets b's edge
-    ///   within its segment, and left out where the fans from b's edge through either solid's
-    ///   edge miss a ([`fan_misses`]).
+    ///   an edge of b ([`three_lines`], a quadric), left out where the fans from b's edge
+    ///   through either solid's edge miss a ([`fan_misses`]), and kept on the arc where it is
+    ///   real, sampled along b's edge ([`real_arc`]; guarded to where the line meets b's edge
+    ///   within its segment where the samples cannot bound it).
     ///
     /// The overlap of the two shadows grows like δ² on one side of each, as a corner's does.
     /// `None` where a vertex lies behind b's plane (the solid's part in front has vertices
@@ -1254,8 +1420,16 @@ impl<T: Real> PolygonEvents<T> {
                         continue;
                     }
                     let Some(quadric) = three_lines((i0, i1), (j0, j1), (b0, b1)) else { continue };
-                    let di = i1 - i0;
-                    room &= self.push_quadric(outer, quadric.guarded(di.cross(b0 - i0), -di.cross(b1 - i0)));
+                    let lines = ((i0, i1), (j0, j1), (b0, b1));
+                    let outlines = (outline(x, i0, i1), outline(y, j0, j1));
+                    match real_arc(outer, outer_rect, lines, outlines, tolerance) {
+                        Arc::Never => {}
+                        Arc::Within(guard) => room &= self.push_quadric_within(outer, quadric, guard),
+                        Arc::Whole => {
+                            let di = i1 - i0;
+                            room &= self.push_quadric(outer, quadric.guarded(di.cross(b0 - i0), -di.cross(b1 - i0)));
+                        }
+                    }
                 }
             }
         }
