@@ -135,6 +135,8 @@ pub(super) struct Events<T, const N: usize, const SB: usize, const TB: usize> {
     /// An occluder touches the outer patch inside it (a box standing on it): J is singular
     /// along the contact's outline.
     touched_inside: bool,
+    /// Curves where two solids' shadows meet were added (`PolygonEvents::push_meeting`).
+    meeting: bool,
 }
 
 /// The events of an occluder that gives its quadrics (a sphere), or of a curved inner patch.
@@ -150,7 +152,19 @@ impl<T: Real, const N: usize, const SB: usize, const TB: usize> Events<T, N, SB,
             limit,
             graded_sides: [false; 4],
             touched_inside: false,
+            meeting: false,
         }
+    }
+
+    /// Records that curves where two solids' shadows meet were added.
+    pub(super) fn set_meeting(&mut self) {
+        self.meeting = true;
+    }
+
+    /// Whether an occluder touches the outer patch inside it and two solids' shadows meet: the
+    /// curves are many and the rule still converges only algebraically along the contact.
+    pub(super) fn touched_and_meeting(&self) -> bool {
+        self.touched_inside && self.meeting
     }
 
     /// Records that an occluder touches the outer patch inside it ([`Self::touches_side`]).

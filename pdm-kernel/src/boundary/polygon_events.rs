@@ -1321,6 +1321,7 @@ impl<T: Real> PolygonEvents<T> {
                 let x = Solid::of_label(casters, &labels, u8::try_from(i + 1).ok()?)?;
                 let y = Solid::of_label(casters, &labels, u8::try_from(j + 1).ok()?)?;
                 room &= events.push_meeting(outer, outer_rect, (&x, &y), front, (bo, unit_b), &ac, tolerance)?;
+                events.set_meeting();
             }
         }
         planes &= events.push_line(outer, outer_rect, Quadric::plane(bo, unit_b));
