@@ -938,14 +938,14 @@ fn real_arc<T: Real>(
     let step = T::ONE / T::from_usize(ARC_SAMPLES - 1);
     let at = |m: T| sample(m * step);
     let (mut first, mut last) = (None, None);
-    for m in 0..ARC_SAMPLES {
-        match at(T::from_usize(m)) {
-            Some((_, true, _)) => {
-                first = first.or(Some(m));
-                last = Some(m);
-            }
-            Some(_) => {}
-            None => return Arc::Whole,
+    // Each sample's side of a's plane, for the check below.
+    let mut sides = [false; ARC_SAMPLES];
+    for (m, slot) in sides.iter_mut().enumerate() {
+        let Some((_, real, side)) = at(T::from_usize(m)) else { return Arc::Whole };
+        *slot = side;
+        if real {
+            first = first.or(Some(m));
+            last = Some(m);
         }
     }
     let (Some(first), Some(last)) = (first, last) else { return Arc::Never };
@@ -953,14 +953,13 @@ fn real_arc<T: Real>(
     // one halfway; where the line turns to the other side of a's plane on it, p passes
     // through infinity and no chord bounds it.
     let (lo, hi) = (T::from_usize(first) - T::ONE, T::from_usize(last) + T::ONE);
-    let (Some((a, _, towards)), Some((b, _, _)), Some((middle, _, _))) = (at(lo), at(hi), at((lo + hi) * T::HALF))
+    let (Some((a, _, towards)), Some((b, _, beyond)), Some((middle, _, _))) = (at(lo), at(hi), at((lo + hi) * T::HALF))
     else {
         return Arc::Whole;
     };
-    for m in first.saturating_sub(1)..=(last + 1) {
-        if at(T::from_usize(m)).is_none_or(|(_, _, side)| side != towards) {
-            return Arc::Whole;
-        }
+    let within = sides.get(first.saturating_sub(1)..=last.min(ARC_SAMPLES - 1)).unwrap_or_default();
+    if beyond != towards || within.iter().any(|&side| side != towards) {
+        return Arc::Whole;
     }
     let (vt, vs) = (b.0 - a.0, b.1 - a.1);
     let side = |(t, s): (T, T)| vt * (s - a.1) - vs * (t - a.0);
