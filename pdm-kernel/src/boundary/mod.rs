@@ -739,7 +739,11 @@ fn distance_to_part<T: Real, S: Surface<T> + ?Sized>(
 /// pair whose balls are farther apart than that gap is not very near; one whose centre points
 /// (the surfaces at the parts' parameter centres) are closer is. Where the parts' balls are
 /// below [`NEAR_RESOLUTION`] of the limit, past [`MAX_NEAR_DEPTH`] halvings of both, or where
-/// a part falls below the coordinates' resolution, the centre points decide.
+/// a part falls below the coordinates' resolution, the centre points decide. Where one patch
+/// is a parallelogram its distance from a point is exact ([`distance_to_parallelogram`]), and
+/// only the other is refined ([`parts_near_parallelogram`]): the pairs of parts along a gap
+/// close to the limit were refined to the resolution on both sides (a half sphere 1 above a
+/// 2 × 2 square: 8 ms per call, whatever the order).
 pub(crate) fn very_near<T, SA, SB>(a: &Patch<'_, T, SA>, b: &Patch<'_, T, SB>) -> Result<bool, PdmError>
 where
     T: Real,
@@ -751,7 +755,48 @@ where
     if !(limit > T::ZERO) {
         return Ok(false);
     }
+    #[cfg(feature = "closed-form")]
+    {
+        if let Some(map) = b.surface().affine_map() {
+            return Ok(parts_near_parallelogram(a, ball_a, map, b.rect(), limit, 0));
+        }
+        if let Some(map) = a.surface().affine_map() {
+            return Ok(parts_near_parallelogram(b, ball_b, map, a.rect(), limit, 0));
+        }
+    }
     parts_near(a, ball_a, b, ball_b, limit, 0)
+}
+
+/// [`very_near`] on the part a (ball `ba`) against the part r of the parallelogram `map`: a
+/// part whose ball is farther from it than the limit is not very near; one whose centre point
+/// is closer is. Where the part's ball is below [`NEAR_RESOLUTION`] of the limit, past
+/// 2·[`MAX_NEAR_DEPTH`] halvings, or where a part falls below the coordinates' resolution, the
+/// centre point decides.
+#[cfg(feature = "closed-form")]
+fn parts_near_parallelogram<T, S>(
+    a: &Patch<'_, T, S>,
+    ba: Ball<T>,
+    map: (Vec3<T>, Vec3<T>, Vec3<T>),
+    r: ParamRect<T>,
+    limit: T,
+    depth: u32,
+) -> bool
+where
+    T: Real,
+    S: Surface<T> + ?Sized,
+{
+    let distance = distance_to_parallelogram(ba.center, map, r);
+    if !(distance - ba.radius < limit) {
+        return false;
+    }
+    let decided = distance < limit;
+    if decided || ba.radius < T::from_f64(NEAR_RESOLUTION) * limit || depth >= 2 * MAX_NEAR_DEPTH {
+        return decided;
+    }
+    (0..4).any(|k| match Patch::new(a.surface(), a.rect().cell(k / 2, k % 2, 2, 2)) {
+        Ok(part) => parts_near_parallelogram(&part, part.enclosing_ball(), map, r, limit, depth + 1),
+        Err(_) => decided,
+    })
 }
 
 /// [`very_near`] on the parts a and b (patches of the original two) with balls `ba`, `bb`.
@@ -1206,5 +1251,44 @@ mod tests {
             answered > cases / 2 && shadowed > cases / 4,
             "answered {answered} of {cases}, {shadowed} shadowed, worst {worst:.1e}"
         );
+    }
+
+    /// `very_near` against a parallelogram refines only the other patch, with the exact
+    /// distance to the parallelogram; it decides as the refinement of both patches
+    /// (`parts_near`) and as the true gap does, wherever that gap is not within the decision's
+    /// resolution of the limit. Sphere cells (the lower hemisphere in halves, its pole cap, a
+    /// cell off the pole) above a 2 × 2 square, gaps from 1e-3 to 4 radii, both argument
+    /// orders.
+    #[test]
+    fn very_near_against_a_parallelogram_decides_as_the_gap() {
+        let square = Parallelogram::new(vec3(-1.0, -1.0, 0.0), vec3(2.0, 0.0, 0.0), vec3(0.0, 2.0, 0.0)).unwrap();
+        let plate = Patch::whole(&square).unwrap();
+        let pi = core::f64::consts::PI;
+        let mut decided = [0usize; 2];
+        for gap in [1e-3, 0.05, 0.2, 0.4, 0.6, 0.8, 1.0, 1.2, 1.5, 2.0, 4.0] {
+            let sphere = Sphere::outer(vec3(0.1, -0.2, 1.0 + gap), 1.0).unwrap();
+            for rect in [
+                ParamRect::new(pi / 2.0, pi, 0.0, pi).unwrap(),
+                ParamRect::new(pi / 2.0, pi, pi, 2.0 * pi).unwrap(),
+                ParamRect::new(7.0 * pi / 8.0, pi, 0.0, 2.0 * pi).unwrap(),
+                ParamRect::new(pi / 2.0, 3.0 * pi / 4.0, 0.5, 1.5).unwrap(),
+            ] {
+                let cell = Patch::new(&sphere, rect).unwrap();
+                let (ball_cell, ball_plate) = (cell.enclosing_ball(), plate.enclosing_ball());
+                let limit = VERY_NEAR * ball_cell.radius.min(ball_plate.radius);
+                let both = parts_near(&cell, ball_cell, &plate, ball_plate, limit, 0).unwrap();
+                let one = very_near(&cell, &plate).unwrap();
+                assert_eq!(one, very_near(&plate, &cell).unwrap());
+                // The cell's lowest points: on its parallel nearest the south pole (φ = π), some
+                // of them straight above the square.
+                let lowest = 1.0 + rect.t1.cos() + gap;
+                if (lowest - limit).abs() > 2.0 * NEAR_RESOLUTION * limit {
+                    assert_eq!(one, lowest < limit, "gap {gap}, cell {rect:?}: limit {limit}, lowest {lowest}");
+                    assert_eq!(one, both, "gap {gap}, cell {rect:?}");
+                    decided[usize::from(one)] += 1;
+                }
+            }
+        }
+        assert!(decided[0] >= 8 && decided[1] >= 8, "{decided:?}");
     }
 }
