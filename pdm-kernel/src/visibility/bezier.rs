@@ -28,6 +28,17 @@ fn net_ball<T: Real>(net: &Net<T>) -> (Vec3<T>, T) {
         }
     }
     let c = c.scale(T::ONE / T::from_f64(16.0));
+    let mut r2 = T::ZERO;
+    for row in net {
+        for &p in row {
+            r2 = r2.max((p - c).norm2());
+        }
+    }
+    // One root of the largest square (a square that overflows or underflows falls back to
+    // the distances one by one).
+    if r2 < T::MAX && r2 > T::MIN_POSITIVE / T::EPSILON {
+        return (c, r2.sqrt());
+    }
     let mut r = T::ZERO;
     for row in net {
         for &p in row {
@@ -66,26 +77,24 @@ fn halve<T: Real>(p: [Vec3<T>; 4]) -> ([Vec3<T>; 4], [Vec3<T>; 4]) {
     ([p[0], a, ab, m], [m, bc, c, p[3]])
 }
 
-/// The net with rows and columns exchanged.
-fn transpose<T: Copy>(n: &Net<T>) -> Net<T> {
-    [
-        [n[0][0], n[1][0], n[2][0], n[3][0]],
-        [n[0][1], n[1][1], n[2][1], n[3][1]],
-        [n[0][2], n[1][2], n[2][2], n[3][2]],
-        [n[0][3], n[1][3], n[2][3], n[3][3]],
-    ]
-}
-
 /// The net split at s = ½ (columns) into two nets.
 fn split_s<T: Real>(net: &Net<T>) -> (Net<T>, Net<T>) {
     let halves = net.map(halve);
     (halves.map(|h| h.0), halves.map(|h| h.1))
 }
 
-/// The net split at t = ½ (rows) into two nets.
+/// The net split at t = ½ (rows) into two nets: de Casteljau on whole rows, as [`halve`]
+/// on each column.
 fn split_t<T: Real>(net: &Net<T>) -> (Net<T>, Net<T>) {
-    let (lo, hi) = split_s(&transpose(net));
-    (transpose(&lo), transpose(&hi))
+    let mix = |a: [Vec3<T>; 4], b: [Vec3<T>; 4]| {
+        let h = T::HALF;
+        [(a[0] + b[0]).scale(h), (a[1] + b[1]).scale(h), (a[2] + b[2]).scale(h), (a[3] + b[3]).scale(h)]
+    };
+    let [r0, r1, r2, r3] = *net;
+    let (a, b, c) = (mix(r0, r1), mix(r1, r2), mix(r2, r3));
+    let (ab, bc) = (mix(a, b), mix(b, c));
+    let m = mix(ab, bc);
+    ([r0, a, ab, m], [m, bc, c, r3])
 }
 
 /// Segment p + τ d, τ ∈ (0, 1), against triangle (a, b, c) (Möller–Trumbore): the crossing's τ.
@@ -127,9 +136,46 @@ impl<T: Real> Probe<T> {
         interior(tau) && tau * self.length > self.margin && (T::ONE - tau) * self.length > self.margin
     }
 
+    /// Whether the segment misses the slab that holds the net's control points (the plane
+    /// through `c` normal to the corners' diagonals, as thick as the farthest control point,
+    /// plus the flatness) within the ball (`c`, `r`) plus the flatness: the sub-patch lies in
+    /// both (convex-hull property). The slab shrinks about four times per subdivision where the
+    /// ball halves, so a segment leaving a nearly flat piece steeply is cut off levels earlier.
+    fn misses_slab(&self, net: &Net<T>, c: Vec3<T>, r: T) -> bool {
+        let normal = (net[3][3] - net[0][0]).cross(net[0][3] - net[3][0]);
+        let length = normal.norm();
+        if !(length > T::ZERO) || !length.is_finite() {
+            return false;
+        }
+        let n = normal.scale(T::ONE / length);
+        let mut thickness = T::ZERO;
+        for row in net {
+            for &x in row {
+                thickness = thickness.max(n.dot(x - c).abs());
+            }
+        }
+        let half = thickness + self.flat;
+        // n·(p + τd − c) = a + τ·b, within ±half on τ ∈ [0, 1].
+        let (a, b) = (n.dot(self.p - c), n.dot(self.d));
+        let (lo, hi) = if b == T::ZERO {
+            if a.abs() > half {
+                return true;
+            }
+            (T::ZERO, T::ONE)
+        } else {
+            let (x, y) = ((-half - a) / b, (half - a) / b);
+            (x.min(y).max(T::ZERO), x.max(y).min(T::ONE))
+        };
+        if !(lo <= hi) {
+            return true;
+        }
+        let (from, to) = (self.p + self.d.scale(lo), self.p + self.d.scale(hi));
+        distance_point_segment(c, from, to) > r + self.flat
+    }
+
     fn hits(&self, net: &Net<T>, level: u32) -> bool {
         let (c, r) = net_ball(net);
-        if distance_point_segment(c, self.p, self.q) > r + self.flat {
+        if distance_point_segment(c, self.p, self.q) > r + self.flat || self.misses_slab(net, c, r) {
             return false;
         }
         if level >= MAX_LEVELS || flatness(net) <= self.flat {
