@@ -323,57 +323,68 @@ fn bezier_blocks_where_the_paraboloid_is_crossed() {
             *p = vec3(-1.0 + 2.0 * i as f64 / 3.0, -1.0 + 2.0 * j as f64 / 3.0, q[i] + q[j]);
         }
     }
-    let dish = BezierPatch::new(net).unwrap();
-    let field = |x: Vec3<f64>| x.z - x.x * x.x - x.y * x.y;
-    let inside = |x: Vec3<f64>| x.x.abs() <= 1.0 && x.y.abs() <= 1.0;
-    let mut state = 777u64;
-    let mut next = || {
-        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-        ((state >> 11) as f64 / (1u64 << 53) as f64) * 3.0 - 1.5
+    // The same dish in the standard frame and turned about an oblique axis: the pruning of
+    // sub-nets (balls, and slabs along each piece's own normal) must not depend on the frame.
+    let turned = |x: Vec3<f64>| {
+        let (c, s) = (0.6f64.cos(), 0.6f64.sin());
+        let k = vec3(1.0, 2.0, -1.0).scale(1.0 / 6f64.sqrt());
+        // Rodrigues: x cos + (k × x) sin + k (k·x)(1 − cos).
+        x.scale(c) + k.cross(x).scale(s) + k.scale(k.dot(x) * (1.0 - c))
     };
-    let (mut blocked, mut clear) = (0, 0);
-    for _ in 0..1000 {
-        let p = vec3(next(), next(), next() + 1.0);
-        let r = vec3(next(), next(), next() + 1.0);
-        const N: usize = 4000;
-        let (mut crossings, mut near, mut closest) = (0, false, f64::MAX);
-        let mut prev: Option<f64> = None;
-        for k in 1..N {
-            let x = p + (r - p).scale(k as f64 / N as f64);
-            let v = field(x);
-            if inside(x) {
-                closest = closest.min(v.abs());
-                if let Some(u) = prev {
-                    if (u < 0.0) != (v < 0.0) {
-                        crossings += 1;
-                        // A crossing next to the rim may fall either side of it.
-                        near |= x.x.abs() > 0.99 || x.y.abs() > 0.99;
+    for turn in [false, true] {
+        let map = |x: Vec3<f64>| if turn { turned(x) } else { x };
+        let dish = BezierPatch::new(net.map(|row| row.map(map))).unwrap();
+        let field = |x: Vec3<f64>| x.z - x.x * x.x - x.y * x.y;
+        let inside = |x: Vec3<f64>| x.x.abs() <= 1.0 && x.y.abs() <= 1.0;
+        let mut state = 777u64;
+        let mut next = || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((state >> 11) as f64 / (1u64 << 53) as f64) * 3.0 - 1.5
+        };
+        let (mut blocked, mut clear) = (0, 0);
+        for _ in 0..1000 {
+            let p = vec3(next(), next(), next() + 1.0);
+            let r = vec3(next(), next(), next() + 1.0);
+            const N: usize = 4000;
+            let (mut crossings, mut near, mut closest) = (0, false, f64::MAX);
+            let mut prev: Option<f64> = None;
+            for k in 1..N {
+                let x = p + (r - p).scale(k as f64 / N as f64);
+                let v = field(x);
+                if inside(x) {
+                    closest = closest.min(v.abs());
+                    if let Some(u) = prev {
+                        if (u < 0.0) != (v < 0.0) {
+                            crossings += 1;
+                            // A crossing next to the rim may fall either side of it.
+                            near |= x.x.abs() > 0.99 || x.y.abs() > 0.99;
+                        }
                     }
+                    prev = Some(v);
+                } else {
+                    prev = None;
                 }
-                prev = Some(v);
+            }
+            // A segment that grazes the surface without crossing it at this sampling.
+            near |= crossings == 0 && closest < 1e-2;
+            if near {
+                continue;
+            }
+            assert_eq!(dish.blocks(map(p), map(r)), crossings > 0, "{p:?} -> {r:?}, turned: {turn}");
+            if crossings > 0 {
+                blocked += 1;
             } else {
-                prev = None;
+                clear += 1;
             }
         }
-        // A segment that grazes the surface without crossing it at this sampling.
-        near |= crossings == 0 && closest < 1e-2;
-        if near {
-            continue;
-        }
-        assert_eq!(dish.blocks(p, r), crossings > 0, "{p:?} -> {r:?}");
-        if crossings > 0 {
-            blocked += 1;
-        } else {
-            clear += 1;
-        }
+        assert!(blocked > 100 && clear > 100, "{blocked} blocked, {clear} clear");
+        // From a point of the dish: up into the bowl and down below it, not blocked; across the
+        // bowl to below the far rim, blocked.
+        let on = map(vec3(0.5, 0.0, 0.25));
+        assert!(!dish.blocks(on, map(vec3(0.4, 0.1, 2.0))));
+        assert!(!dish.blocks(on, map(vec3(0.6, 0.0, -1.0))));
+        assert!(dish.blocks(on, map(vec3(-2.0, 0.0, 1.0))));
     }
-    assert!(blocked > 100 && clear > 100, "{blocked} blocked, {clear} clear");
-    // From a point of the dish: up into the bowl and down below it, not blocked; across the
-    // bowl to below the far rim, blocked.
-    let on = vec3(0.5, 0.0, 0.25);
-    assert!(!dish.blocks(on, vec3(0.4, 0.1, 2.0)));
-    assert!(!dish.blocks(on, vec3(0.6, 0.0, -1.0)));
-    assert!(dish.blocks(on, vec3(-2.0, 0.0, 1.0)));
 }
 
 /// Short chords of the dish between its own points, on its concave side, are not blocked by it
