@@ -77,7 +77,10 @@
 //! agree. A contact the working precision cannot resolve (the rounding band not small against
 //! the shortest edge × the fold angle) is refused with `Err(Degenerate)`; a near contact whose
 //! only unresolved part is the fold angle (parallel patches facing each other across a small gap,
-//! edge above edge) is nearly coincident, not nearly folded, and is reported as `Separate`.
+//! edge above edge) is nearly coincident, not nearly folded, and is reported as `Separate`. So is
+//! a vertex where the patches touch face to face (each with one tangent plane there, the normals
+//! pointing at each other: a sphere's pole resting on a disk's centre): the transforms assume
+//! patches that leave the common point at an angle.
 //!
 //! Files: the local maps, the dispatch over the transforms and the shared grading here;
 //! `classify.rs` (adjacency), `edge.rs`, `vertex.rs`, `identical.rs` (the transforms).
