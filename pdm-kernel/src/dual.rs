@@ -38,13 +38,15 @@ impl<T: Real> Scalar<T> for T {
     fn value(self) -> T {
         self
     }
+    /// A plain value is a sample point's parameter: the fast sine ([`Real::sin_fast`]).
     #[inline(always)]
     fn sin(self) -> Self {
-        Real::sin(self)
+        Real::sin_fast(self)
     }
+    /// A plain value is a sample point's parameter: the fast cosine ([`Real::cos_fast`]).
     #[inline(always)]
     fn cos(self) -> Self {
-        Real::cos(self)
+        Real::cos_fast(self)
     }
     #[inline(always)]
     fn sqrt(self) -> Self {

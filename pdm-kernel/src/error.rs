@@ -39,7 +39,9 @@ pub enum PdmError {
     InvalidResult,
     /// The working precision cannot resolve this pair: its result would keep fewer than half
     /// the precision's digits (terms cancelling by many orders of magnitude, as for strips of
-    /// extreme aspect ratio), so it is refused instead of returned inexact. Use `f64`, or
+    /// extreme aspect ratio), or (with the `micromath` feature, f32) the gap between two
+    /// separate patches is below the error with which its fast sine and cosine place a curved
+    /// surface's points; it is refused instead of returned inexact. Use `f64` (or libm), or
     /// split the surfaces.
     Unresolvable,
     /// A setting outside its valid range (a tolerance that is not positive and finite, a
@@ -73,7 +75,7 @@ impl fmt::Display for PdmError {
                 "form factor outside the physical bounds (not finite, F < 0, F > 1 or A_a*F_ab > min(A_a, A_b))",
             ),
             Self::Unresolvable => f.write_str(
-                "the working precision cannot resolve this pair (its terms cancel by more than half the digits)",
+                "the working precision cannot resolve this pair (its terms cancel by more than half the digits, or its gap is below the fast sine and cosine's error)",
             ),
             Self::InvalidSetting { name, expected } => write!(f, "invalid setting {name}: must be {expected}"),
         }

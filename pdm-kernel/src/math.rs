@@ -1,18 +1,28 @@
 //! The one place that decides which math library answers.
 //!
 //! By default every elementary function comes from `libm` (correctly rounded or within 1 ulp for
-//! the functions used here). With the `micromath` feature the **f32** functions `sqrt`, `sin`,
-//! `cos`, `atan`, `atan2` and `ln` come from micromath's fast approximations instead; f64 always
-//! uses libm. Cargo features are additive: enabling `micromath` anywhere in a build enables it for
-//! every user of the kernel in that build.
+//! the functions used here). With the `micromath` feature two **f32** paths change: `sqrt`
+//! comes from micromath's estimate refined by two Newton steps (≈ 1e-7, as accurate as the
+//! kernel needs), and the sine and cosine that place a curved surface's sample points
+//! (`Real::sin_cos_fast`: the points, normals and parameter maps of spheres, cylinders, cones and
+//! disks — the per-sample cost) come from micromath's fast approximations. Every other `sin`,
+//! `cos`, `atan`, `atan2` and `ln` stays libm's, and f64 always uses libm. Cargo features are
+//! additive: enabling `micromath` anywhere in a build enables it for every user of the kernel
+//! in that build.
+//!
+//! Why only those: the other calls are closed forms (the contour form's edge pairs, the
+//! point-to-polygon J, a sphere's cone of directions), events and proofs (normal cones), whose
+//! terms cancel to a value up to hundreds of times smaller. micromath's versions are off by
+//! up to 1.1e-3 (`sin`, `cos`, absolute), 2.8e-3 (`atan2`), 6e-2 relative (`atan` near 0) and
+//! 0.12 (`ln`, absolute); with them in the closed forms two adjacent cube faces came out
+//! 4.4 % high and opposite faces past the sphere 4.5 %, their tolerance-mode estimates 10–1000×
+//! below that.
 //!
 //! Accuracy cost of `micromath` (measured by `tests/integration/tests/precision_backends.rs`,
-//! see RESULTS.md "Precision backends"): micromath's `sin`/`cos`/`atan` are accurate to about 1e-3;
-//! its `sqrt` (a bit-trick estimate, ≈ 5 % off) is refined here by two Newton steps to ≈ 1e-7.
-//! On form factors in f32: C-11 squares 1.1e-6 (as libm: only `sqrt` is involved), C-41 disks
-//! 3.7e-4, sphere → cube face 7.0e-4, against 6e-7…1e-6 with libm. Points placed by sin/cos lie
-//! up to ≈ 1e-3 off their surface, so the occlusion tests widen their "on the surface" band to
-//! [`crate::Real::ELEMENTARY_ERROR`]. Use micromath where three digits suffice.
+//! see RESULTS.md "Precision backends"): sample points lie up to ≈ 1e-3 (relative to the
+//! surface's radius) off their surface, so the occlusion tests widen their "on the surface"
+//! band to [`crate::Real::ELEMENTARY_ERROR`], and the tolerance mode counts it in every
+//! estimate. Use micromath where three digits suffice.
 
 /// f64 functions: always libm.
 pub(crate) mod f64m {
@@ -33,6 +43,19 @@ pub(crate) mod f64m {
     #[inline(always)]
     pub(crate) fn sin_cos(x: f64) -> (f64, f64) {
         libm::sincos(x)
+    }
+    /// The surfaces' sample points' sine and cosine: here the same as [`sin_cos`].
+    #[inline(always)]
+    pub(crate) fn sin_cos_fast(x: f64) -> (f64, f64) {
+        sin_cos(x)
+    }
+    #[inline(always)]
+    pub(crate) fn sin_fast(x: f64) -> f64 {
+        sin(x)
+    }
+    #[inline(always)]
+    pub(crate) fn cos_fast(x: f64) -> f64 {
+        cos(x)
     }
     #[inline(always)]
     pub(crate) fn atan2(y: f64, x: f64) -> f64 {
@@ -73,6 +96,19 @@ pub(crate) mod f32m {
     pub(crate) fn sin_cos(x: f32) -> (f32, f32) {
         libm::sincosf(x)
     }
+    /// The surfaces' sample points' sine and cosine: here the same as [`sin_cos`].
+    #[inline(always)]
+    pub(crate) fn sin_cos_fast(x: f32) -> (f32, f32) {
+        sin_cos(x)
+    }
+    #[inline(always)]
+    pub(crate) fn sin_fast(x: f32) -> f32 {
+        sin(x)
+    }
+    #[inline(always)]
+    pub(crate) fn cos_fast(x: f32) -> f32 {
+        cos(x)
+    }
     #[inline(always)]
     pub(crate) fn atan2(y: f32, x: f32) -> f32 {
         libm::atan2f(y, x)
@@ -95,7 +131,8 @@ pub(crate) mod f32m {
 #[cfg(feature = "micromath")]
 pub(crate) mod f32m {
     use micromath::F32Ext;
-    /// Relative error bound of micromath's sin/cos/atan (≈ 1e-3 measured, 2e-3 with margin).
+    /// Error bound of micromath's sin/cos (1.09e-3 absolute measured over [−7, 7], 2e-3 with
+    /// margin).
     pub(crate) const ELEMENTARY_ERROR: f32 = 2.0e-3;
     /// micromath's estimate (≈ 5 % off on its own) refined by two Newton steps
     /// y ← (y + x/y)/2, each squaring the relative error: ≈ 1e-7 afterwards.
@@ -110,27 +147,40 @@ pub(crate) mod f32m {
     }
     #[inline(always)]
     pub(crate) fn sin(x: f32) -> f32 {
-        F32Ext::sin(x)
+        libm::sinf(x)
     }
     #[inline(always)]
     pub(crate) fn cos(x: f32) -> f32 {
-        F32Ext::cos(x)
+        libm::cosf(x)
     }
     #[inline(always)]
     pub(crate) fn sin_cos(x: f32) -> (f32, f32) {
+        libm::sincosf(x)
+    }
+    /// The surfaces' sample points' sine and cosine: micromath's approximations.
+    #[inline(always)]
+    pub(crate) fn sin_cos_fast(x: f32) -> (f32, f32) {
         (F32Ext::sin(x), F32Ext::cos(x))
     }
     #[inline(always)]
+    pub(crate) fn sin_fast(x: f32) -> f32 {
+        F32Ext::sin(x)
+    }
+    #[inline(always)]
+    pub(crate) fn cos_fast(x: f32) -> f32 {
+        F32Ext::cos(x)
+    }
+    #[inline(always)]
     pub(crate) fn atan2(y: f32, x: f32) -> f32 {
-        F32Ext::atan2(y, x)
+        libm::atan2f(y, x)
     }
     #[inline(always)]
     pub(crate) fn atan(x: f32) -> f32 {
-        F32Ext::atan(x)
+        libm::atanf(x)
     }
     #[inline(always)]
     pub(crate) fn ln(x: f32) -> f32 {
-        F32Ext::ln(x)
+        libm::logf(x)
     }
     #[inline(always)]
     pub(crate) fn abs(x: f32) -> f32 {

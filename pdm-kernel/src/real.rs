@@ -64,9 +64,9 @@ pub trait Real:
     const GEOMETRY_TOLERANCE: Self;
     /// Number of mantissa bits (24 or 53); used in docs and tests.
     const MANTISSA_DIGITS: u32;
-    /// Relative error bound of the elementary functions of the active math backend (a couple of
-    /// ε with libm; ≈ 2e-3 for f32 with the `micromath` feature). Points computed through
-    /// sin/cos lie this far (relatively) off their exact surface.
+    /// Error bound of [`Self::sin_cos_fast`] (a couple of ε with libm; 2e-3 for f32 with the
+    /// `micromath` feature): sample points of curved surfaces lie this far, relative to the
+    /// surface's size, off their exact surface.
     const ELEMENTARY_ERROR: Self;
 
     /// Converts an `f64` constant to this width (rounding to nearest for `f32`).
@@ -83,6 +83,15 @@ pub trait Real:
     fn cos(self) -> Self;
     /// Sine and cosine together (one argument reduction with libm).
     fn sin_cos(self) -> (Self, Self);
+    /// Sine and cosine of a surface parameter where a sample point or its normal is placed:
+    /// micromath's approximations for f32 with the `micromath` feature (about 1e-3), else
+    /// [`Self::sin_cos`]. Only the surfaces' point and normal maps call it; closed forms,
+    /// events and proofs use the accurate functions.
+    fn sin_cos_fast(self) -> (Self, Self);
+    /// Sine of a surface parameter, as [`Self::sin_cos_fast`].
+    fn sin_fast(self) -> Self;
+    /// Cosine of a surface parameter, as [`Self::sin_cos_fast`].
+    fn cos_fast(self) -> Self;
     /// Four-quadrant arctangent of `self / x` (through the math backend).
     fn atan2(self, x: Self) -> Self;
     /// Arctangent (through the math backend).
@@ -144,6 +153,18 @@ macro_rules! impl_real {
             #[inline(always)]
             fn sin_cos(self) -> (Self, Self) {
                 math::$math::sin_cos(self)
+            }
+            #[inline(always)]
+            fn sin_cos_fast(self) -> (Self, Self) {
+                math::$math::sin_cos_fast(self)
+            }
+            #[inline(always)]
+            fn sin_fast(self) -> Self {
+                math::$math::sin_fast(self)
+            }
+            #[inline(always)]
+            fn cos_fast(self) -> Self {
+                math::$math::cos_fast(self)
             }
             #[inline(always)]
             fn atan2(self, x: Self) -> Self {

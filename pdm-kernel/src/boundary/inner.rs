@@ -587,9 +587,12 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
     /// J(p) = ∫_b visible (n̂_p·e)(−n_q·e)/L⁴ dq (without the 1/π) over the part r of b,
     /// refined towards p: a part that p is [`near`](Self::near) is split 2 × 2 (up to
     /// [`MAX_NEAR_DEPTH`] times), so that every part is integrated from at least its own radius
-    /// away and the rule's error falls like 2^(−2·order) or faster whatever the gap.
+    /// away and the rule's error falls like 2^(−2·order) or faster whatever the gap. A part
+    /// whose halves the working precision cannot hold (f32, with p on b to within rounding or
+    /// the sample points' own error) is integrated as it is.
     pub(super) fn refined(&self, p: Vec3<T>, np: Vec3<T>, r: ParamRect<T>, depth: u32) -> Result<T, PdmError> {
-        if depth < MAX_NEAR_DEPTH && self.near(p, &self.ball_of(r)?) {
+        let halves = || r.cell(0, 0, 2, 2).validate().is_ok() && r.cell(1, 1, 2, 2).validate().is_ok();
+        if depth < MAX_NEAR_DEPTH && self.near(p, &self.ball_of(r)?) && halves() {
             let mut sum = T::ZERO;
             for k in 0..4 {
                 sum += self.refined(p, np, r.cell(k / 2, k % 2, 2, 2), depth + 1)?;

@@ -750,8 +750,19 @@ where
     SA: Surface<T> + ?Sized,
     SB: Surface<T> + ?Sized,
 {
+    let limit = T::from_f64(VERY_NEAR) * a.enclosing_ball().radius.min(b.enclosing_ball().radius);
+    gap_below(a, b, limit)
+}
+
+/// Whether the gap between the patches is below `limit`, to within [`NEAR_RESOLUTION`] of it
+/// (as [`very_near`] decides).
+pub(crate) fn gap_below<T, SA, SB>(a: &Patch<'_, T, SA>, b: &Patch<'_, T, SB>, limit: T) -> Result<bool, PdmError>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+{
     let (ball_a, ball_b) = (a.enclosing_ball(), b.enclosing_ball());
-    let limit = T::from_f64(VERY_NEAR) * ball_a.radius.min(ball_b.radius);
     if !(limit > T::ZERO) {
         return Ok(false);
     }

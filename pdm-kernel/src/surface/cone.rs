@@ -83,7 +83,8 @@ impl<T: Real> Surface<T> for Cone<T> {
     fn normal(&self, theta: T, z: T) -> Vec3<T> {
         let k = self.slope();
         let r = self.base_radius + k * z;
-        let n = self.frame.combine(theta.cos(), theta.sin(), -k).scale(r);
+        let (sin, cos) = theta.sin_cos_fast();
+        let n = self.frame.combine(cos, sin, -k).scale(r);
         if self.side == Side::Inner {
             -n
         } else {

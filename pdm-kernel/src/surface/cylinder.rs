@@ -87,7 +87,8 @@ impl<T: Real> Surface<T> for Cylinder<T> {
         self.map(theta, z)
     }
     fn normal(&self, theta: T, _z: T) -> Vec3<T> {
-        let n = self.frame.combine(theta.cos(), theta.sin(), T::ZERO).scale(self.radius);
+        let (sin, cos) = theta.sin_cos_fast();
+        let n = self.frame.combine(cos, sin, T::ZERO).scale(self.radius);
         if self.side == Side::Inner {
             -n
         } else {

@@ -107,8 +107,8 @@ impl<T: Real> Surface<T> for Sphere<T> {
     }
     /// Eq. (19) and eq. (21): n = r² sin φ · (unit radial direction).
     fn point_and_normal(&self, phi: T, theta: T) -> (Vec3<T>, Vec3<T>) {
-        let (sp, cp) = phi.sin_cos();
-        let (st, ct) = theta.sin_cos();
+        let (sp, cp) = phi.sin_cos_fast();
+        let (st, ct) = theta.sin_cos_fast();
         let radial = self.frame.combine(sp * ct, sp * st, cp);
         let p = self.center + radial.scale(self.radius);
         let n = radial.scale(self.radius * self.radius * sp);
