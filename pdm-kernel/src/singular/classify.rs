@@ -373,16 +373,18 @@ fn tangent_normal<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>, k: usize
         (length > T::ZERO && length.is_finite()).then(|| n.scale(T::ONE / length))
     };
     let quarter = T::from_f64(0.25);
-    let samples: [(T, T); 5] = match (along_t, along_s) {
-        (false, false) => [(inset, inset), (inset, T::ZERO), (T::ZERO, inset), (inset, inset), (inset, inset)],
+    let (samples, count): ([(T, T); 5], usize) = match (along_t, along_s) {
+        (false, false) => {
+            ([(inset, inset), (inset, T::ZERO), (T::ZERO, inset), (T::ZERO, T::ZERO), (T::ZERO, T::ZERO)], 3)
+        }
         // The side along t collapses: the normals along it, just inside in s.
-        (true, false) => [T::ZERO, quarter, T::HALF, T::HALF + quarter, T::ONE].map(|u| (u, inset)),
-        (false, true) => [T::ZERO, quarter, T::HALF, T::HALF + quarter, T::ONE].map(|v| (inset, v)),
+        (true, false) => ([T::ZERO, quarter, T::HALF, T::HALF + quarter, T::ONE].map(|u| (u, inset)), 5),
+        (false, true) => ([T::ZERO, quarter, T::HALF, T::HALF + quarter, T::ONE].map(|v| (inset, v)), 5),
         (true, true) => return None,
     };
     let first = at(samples[0].0, samples[0].1)?;
     let limit = T::ONE - T::from_f64(TANGENT_SPREAD);
-    for (u, v) in samples {
+    for &(u, v) in samples.iter().take(count).skip(1) {
         if !(at(u, v)?.dot(first) >= limit) {
             return None;
         }
