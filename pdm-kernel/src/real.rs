@@ -110,6 +110,14 @@ pub trait Real:
     fn gauss_table(order: usize) -> Option<(&'static [Self], &'static [Self])>;
 }
 
+/// `true` where [`Real::sin_cos_fast`] is an approximation (micromath's, f32) rather than
+/// libm's: sample points of curved surfaces then lie [`Real::ELEMENTARY_ERROR`] off their
+/// surface, which the pair methods refuse or allow for (`pair::backend_resolves`,
+/// `adaptive::backend_allowance`).
+pub(crate) fn approximate_sin_cos<T: Real>() -> bool {
+    T::ELEMENTARY_ERROR > T::from_f64(16.0) * T::EPSILON
+}
+
 macro_rules! impl_real {
     ($t:ty, $nodes:ident, $weights:ident, $tol:expr, $math:ident) => {
         impl Real for $t {

@@ -155,10 +155,11 @@ const TERMINATOR_MARGIN: f64 = 0.1;
 /// [`Real::ELEMENTARY_ERROR`] (relative to the surface's size) off the surface and turn their
 /// normals by as much, so the value is that of slightly different surfaces: an error no
 /// comparison of orders or halves can see. It is bounded by 2·`ELEMENTARY_ERROR` times the
-/// pair's sensitivity magnitude S = ∫∫ (|cos θ_a| + sin θ_a)(|cos θ_b| + sin θ_b) / (π L²)
-/// dA_a dA_b over the whole patches, facing or not, visible or not (a turned normal changes
-/// cos θ by up to the turn times sin θ, so grazing and sliver pairs, whose values are far
-/// below their S, get an allowance on S's scale), summed at order 8. The factor is measured,
+/// pair's sensitivity magnitude S = ∫∫ (sin θ_a cos⁺θ_b + cos⁺θ_a sin θ_b + 2 cos⁺θ_a cos⁺θ_b)
+/// / (π L²) dA_a dA_b (cos⁺ = max(cos, 0)) over the sample pairs that face each other to
+/// within cos θ > −[`TERMINATOR_MARGIN`] on both sides, visible or not (a turned normal
+/// changes cos θ by up to the turn times sin θ, so grazing and sliver pairs, whose values are
+/// far below their S, get an allowance on S's scale), summed at order 8. The factor is measured,
 /// not proved: on the sphere-in-cube scene's 355 cell pairs (sphere 4 × 8 and faces 3 × 3:
 /// sphere cells against a face, faces against faces past the sphere; f32 with micromath
 /// against f64) the largest error is 0.14 of the estimate, whose median is 2.4e-2 of the value.
@@ -169,7 +170,7 @@ where
     SA: Surface<T> + ?Sized,
     SB: Surface<T> + ?Sized,
 {
-    if !(T::ELEMENTARY_ERROR > T::from_f64(16.0) * T::EPSILON) {
+    if !crate::real::approximate_sin_cos::<T>() {
         return Ok(T::ZERO);
     }
     let (sa, sb) = (PatchSamples::<T, CAP>::new(a, 8)?, PatchSamples::<T, CAP>::new(b, 8)?);

@@ -112,7 +112,7 @@ where
     SA: Surface<T> + ?Sized,
     SB: Surface<T> + ?Sized,
 {
-    if !(T::ELEMENTARY_ERROR > T::from_f64(16.0) * T::EPSILON) {
+    if !crate::real::approximate_sin_cos::<T>() {
         return Ok(());
     }
     let limit = T::ELEMENTARY_ERROR * trig_size(a).max(trig_size(b));
