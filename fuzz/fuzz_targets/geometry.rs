@@ -421,7 +421,10 @@ fn run<T: Real>(input: &Input) {
             Some(x) => x.get::<T>(),
             None => T::from_f64(10f64.powi(-1 - i32::from(k % 10))),
         };
-        let settings = Adaptive { tolerance, max_order: ADAPTIVE_MAX_ORDER, max_depth: u32::from(depth % 3) };
+        // An absolute budget on every other input: 0, or the tolerance times a tenth of the smaller area.
+        let area = |p: &Patch<'_, T, _>| p.area(8).unwrap_or(T::ZERO);
+        let absolute = if k % 2 == 0 { T::ZERO } else { tolerance * T::from_f64(0.1) * area(&a).min(area(&b)) };
+        let settings = Adaptive { tolerance, max_order: ADAPTIVE_MAX_ORDER, max_depth: u32::from(depth % 3), absolute };
         let r = adaptive_exchange::<T, _, _, _, ADAPTIVE_CAP>(&a, &b, settings, &occ);
         if let Ok(e) = r {
             let error = e.error.expect("adaptive_exchange: the tolerance mode always estimates");

@@ -60,6 +60,9 @@ fn bad_input_is_one_line_and_exit_code_2() {
         vec!["matrix", bad.to_str().unwrap()],
         vec!["matrix", "/nonexistent/scene.toml"],
         vec!["matrix", bad.to_str().unwrap(), "--tolerance", "-1"],
+        vec!["matrix", bad.to_str().unwrap(), "--absolute", "-1e-9"],
+        vec!["matrix", bad.to_str().unwrap(), "--absolute", "nan"],
+        vec!["matrix", bad.to_str().unwrap(), "--absolute", "1e-9", "--order", "8"],
     ] {
         let out = pdm(&args);
         assert_eq!(out.status.code(), Some(2), "{args:?}");
@@ -67,6 +70,9 @@ fn bad_input_is_one_line_and_exit_code_2() {
         assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
         assert!(stderr.starts_with("error:"), "{stderr}");
     }
+    let out = pdm(&["matrix", bad.to_str().unwrap(), "--absolute", "-1e-9"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("-1e-9") && stderr.contains("absolute tolerance must be in 0..=1"), "{stderr}");
     let out = pdm(&["matrix", bad.to_str().unwrap()]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.contains("bad.toml:1: surface #1 'd': field `radius` -1 must be positive"), "{stderr}");

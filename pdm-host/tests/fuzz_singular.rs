@@ -982,7 +982,7 @@ fn check_adaptive(case: &EdgeCase, tolerance: f64, stats: &mut Stats) -> Result<
     let (floor, flap) = case.build::<f64>().map_err(|e| TestCaseError::fail(format!("build: {e:?}")))?;
     let (a, b) = (floor.cell(0, 1), flap.cell(0, 1));
     // Small limits keep one case cheap (≤ 2⁴ leaf pairs, touching orders ≤ 12).
-    let settings = Adaptive { tolerance, max_order: 12, max_depth: 4 };
+    let settings = Adaptive { tolerance, max_order: 12, max_depth: 4, absolute: 0.0 };
     let kind = match classify_near(&a, &b).0 {
         Adjacency::Separate => "separate",
         Adjacency::SharedEdge { .. } if case.gap == 0.0 => "edge",
@@ -1378,8 +1378,12 @@ fn adaptive_nearly_folded_separate_pair_is_refused() {
         "pair_exchange (16, 12): {:?}",
         pair_exchange::<f64, _, _, _, 1024>(&a, &b, settings(16, 12), &()).map(|e| e.value)
     );
-    let e =
-        adaptive_exchange::<f64, _, _, _, 256>(&a, &b, Adaptive { tolerance: 1e-3, max_order: 12, max_depth: 4 }, &());
+    let e = adaptive_exchange::<f64, _, _, _, 256>(
+        &a,
+        &b,
+        Adaptive { tolerance: 1e-3, max_order: 12, max_depth: 4, absolute: 0.0 },
+        &(),
+    );
     println!("adaptive_exchange (1e-3, 12, 4): {e:?}");
     let e = e.unwrap();
     assert!((e.value - reference).abs() <= e.error.unwrap(), "{e:?} vs {reference}");
@@ -1402,9 +1406,13 @@ fn adaptive_touching_pair_estimate_below_the_actual_error() {
         let x = touching_exchange(&a, &b, near, gap, order, &()).unwrap();
         println!("order {order}: {x:.16e}, error {:+.2e}", x - reference);
     }
-    let e =
-        adaptive_exchange::<f64, _, _, _, 256>(&a, &b, Adaptive { tolerance: 1e-3, max_order: 12, max_depth: 4 }, &())
-            .unwrap();
+    let e = adaptive_exchange::<f64, _, _, _, 256>(
+        &a,
+        &b,
+        Adaptive { tolerance: 1e-3, max_order: 12, max_depth: 4, absolute: 0.0 },
+        &(),
+    )
+    .unwrap();
     let actual = (e.value - reference).abs();
     println!("adaptive: {e:?}, actual error {actual:.2e}");
     assert!(actual <= e.error.unwrap(), "actual {actual:e} > estimate {:e}", e.error.unwrap());
@@ -1523,9 +1531,13 @@ fn seed_20261201_separate_folded_pair_estimate_bounds_the_error() {
         println!("order {order}: {x:.16e}, error {:+.2e}", x - reference);
     }
     for tolerance in [1e-3, 1e-6, 1e-9] {
-        let e =
-            adaptive_exchange::<f64, _, _, _, 256>(&a, &b, Adaptive { tolerance, max_order: 12, max_depth: 4 }, &())
-                .unwrap();
+        let e = adaptive_exchange::<f64, _, _, _, 256>(
+            &a,
+            &b,
+            Adaptive { tolerance, max_order: 12, max_depth: 4, absolute: 0.0 },
+            &(),
+        )
+        .unwrap();
         let actual = (e.value - reference).abs();
         println!("adaptive {tolerance:e}: {e:?}, actual error {actual:.2e}");
         assert!(actual <= e.error.unwrap(), "actual {actual:e} > estimate {:e}", e.error.unwrap());

@@ -119,7 +119,7 @@ fn workload<T: Real, const CAP: usize>(entry: Entry, depth: u32) {
     let cell = Patch::new(&sphere, ParamRect { t0: quarter, t1: T::PI * h, s0: T::PI, s1: T::PI + quarter }).unwrap();
     let settings = PairSettings { order, singular_order: MAX_ORDER, boundaries: true };
     let tolerance = T::from_f64(if T::MANTISSA_DIGITS == 24 { 1e-7 } else { 1e-14 });
-    let adaptive = Adaptive { tolerance, max_order: 12, max_depth: depth };
+    let adaptive = Adaptive { tolerance, max_order: 12, max_depth: depth, absolute: T::ZERO };
     let value = match entry {
         Entry::Surface => surface_form_factor::<T, _, _, _, CAP>(
             PatchGrid::new(&sphere, 2, 4).unwrap(),

@@ -11,7 +11,7 @@ use crate::real::Real;
 ///   and `converged` is `false` (nothing was checked).
 /// - The tolerance mode ([`crate::adaptive_exchange`], [`crate::Method::Tolerance`]) gives
 ///   `error = Some(e)`, an estimate of the absolute error that is meant never to be below it,
-///   and `converged = true` only where `e ≤ tolerance·|value|`.
+///   and `converged = true` only where `e ≤ absolute + tolerance·|value|` ([`crate::Adaptive`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Estimate<T> {

@@ -36,9 +36,10 @@ pub enum Method<T> {
     Plain(Quadrature),
     /// [`crate::pair_exchange`] on every pair: the method each pair needs, at fixed orders.
     Pair(PairSettings),
-    /// [`crate::adaptive_exchange`] on every pair, each to the relative tolerance; the
-    /// estimates add up, and the total is `converged` if every pair met its tolerance or the
-    /// summed estimate meets the tolerance against the summed value.
+    /// [`crate::adaptive_exchange`] on every pair, each to the relative tolerance and an equal
+    /// share of the absolute budget (the budget is the surface pair's); the estimates add up,
+    /// and the total is `converged` if every pair met its tolerance or the summed estimate
+    /// meets the tolerance and budget against the summed value.
     Tolerance(Adaptive<T>),
 }
 
@@ -119,6 +120,9 @@ where
             (sum_pairs(a.clone(), b.clone(), pair)?.0, a.area(order)?, b.area(order)?)
         }
         Method::Tolerance(s) => {
+            // The absolute budget is the whole surface pair's: each patch pair gets its share.
+            let ((ma, na), (mb, nb)) = (a.dims(), b.dims());
+            let s = s.share(ma.saturating_mul(na).saturating_mul(mb).saturating_mul(nb));
             let pair = |pa: &Patch<'_, T, SA>, pb: &Patch<'_, T, SB>| {
                 adaptive_exchange::<T, SA, SB, O, CAP>(pa, pb, s, occluders).map(|e| (e, T::ZERO))
             };
@@ -131,7 +135,7 @@ where
     // A pair of tiny value may miss the tolerance against itself while the total meets it: the
     // summed estimates bound the total's error (judged against the value returned).
     if let (Method::Tolerance(s), Some(error)) = (method, total.error) {
-        converged |= error <= s.tolerance * value.abs();
+        converged |= s.met(value, error);
     }
     Ok(Estimate { value, converged, ..total })
 }

@@ -6,7 +6,7 @@ use std::process::ExitCode;
 use clap::Args;
 use pdm_host::scene::{self, matrix::MatrixError, matrix::PairMethod, matrix::Shard, report};
 
-use super::{parse_order, parse_threads, parse_tolerance, EXIT_FAILURE, EXIT_USAGE};
+use super::{parse_absolute, parse_order, parse_threads, parse_tolerance, EXIT_FAILURE, EXIT_USAGE};
 
 /// Floating-point width.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -27,6 +27,12 @@ pub struct MatrixArgs {
     /// Per-pair relative tolerance of the tolerance mode (the default mode) [default: 1e-6].
     #[arg(long, value_name = "TOL", value_parser = parse_tolerance, conflicts_with = "order", allow_hyphen_values = true)]
     pub tolerance: Option<f64>,
+    /// Absolute tolerance on each surface-to-surface form factor F_IJ of the tolerance mode: an
+    /// entry within it counts as converged even where the relative tolerance is not met (an
+    /// entry that is zero or tiny, a sliver seen past a rim, cannot meet a relative one)
+    /// [default: 1e-2 x the tolerance; 0: relative only].
+    #[arg(long, value_name = "ABS", value_parser = parse_absolute, conflicts_with = "order", allow_hyphen_values = true)]
+    pub absolute: Option<f64>,
     /// Fixed Gauss order per axis instead of a tolerance (no error estimates).
     #[arg(long, value_name = "P", value_parser = parse_order, allow_negative_numbers = true)]
     pub order: Option<usize>,
@@ -174,7 +180,11 @@ pub fn run(args: &MatrixArgs) -> ExitCode {
     }
     let method = match args.order {
         Some(order) => PairMethod::Order { order, singular_order: args.singular_order },
-        None => PairMethod::Tolerance(args.tolerance.unwrap_or(1e-6)),
+        None => {
+            let relative = args.tolerance.unwrap_or(1e-6);
+            let absolute = args.absolute.unwrap_or(scene::matrix::DEFAULT_ABSOLUTE * relative);
+            PairMethod::Tolerance { relative, absolute }
+        }
     };
     let n = scene.patches.len() as u64;
     let needed = scene::matrix::memory_needed(scene.patches.len(), args.shard.map_or(1, |s| s.count));

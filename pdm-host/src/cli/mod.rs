@@ -133,6 +133,14 @@ fn parse_tolerance(s: &str) -> Result<f64, String> {
     }
 }
 
+fn parse_absolute(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(t) if t.is_finite() && (0.0..=1.0).contains(&t) => Ok(t),
+        Ok(_) => Err("the absolute tolerance must be in 0..=1".into()),
+        Err(_) => Err("not a number (the absolute tolerance must be in 0..=1)".into()),
+    }
+}
+
 fn parse_patches(s: &str) -> Result<usize, String> {
     match s.trim() {
         "86" => Ok(86),

@@ -19,9 +19,16 @@ use crate::validate::stack;
 /// How each pair is integrated.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum PairMethod {
-    /// The tolerance mode (`adaptive_exchange`): per-pair relative tolerance, with an error
-    /// estimate for every entry.
-    Tolerance(f64),
+    /// The tolerance mode (`adaptive_exchange`), with an error estimate for every entry. An
+    /// entry counts as converged when its estimate is within `relative` of its value or within
+    /// `absolute` (each surface-to-surface factor F_IJ and F_JI: every patch pair gets the share
+    /// A_i·A_j / max(A_I, A_J) of it, so that the shares of one surface pair add up to it).
+    Tolerance {
+        /// Relative tolerance on each patch pair's exchange.
+        relative: f64,
+        /// Absolute tolerance on each surface-to-surface form factor.
+        absolute: f64,
+    },
     /// Fixed orders (`pair_exchange`): Gauss order for separate pairs, order of the touching
     /// transforms; no error estimate.
     Order {
@@ -35,12 +42,26 @@ pub enum PairMethod {
 /// Largest order of the tolerance mode here (as in `pdm-ff validate`).
 pub const ADAPTIVE_MAX_ORDER: usize = 12;
 
+/// The absolute tolerance of the tolerance mode, when not given, as a fraction of the relative
+/// one: an entry of F below 1e-2 is then judged against 1e-2 · tolerance absolute instead of its
+/// own value. An entry that is zero or tiny cannot meet a relative tolerance at any cost (the
+/// satellite's body top face against the dish's concave side: F ≈ 1e-10 from slivers at the
+/// rim, with estimates about as large; BENCHMARKS.md, "An absolute tolerance for scenes").
+pub const DEFAULT_ABSOLUTE: f64 = 1e-2;
+
 impl PairMethod {
+    /// The tolerance mode at `relative`, with the default absolute tolerance
+    /// ([`DEFAULT_ABSOLUTE`] × `relative`).
+    #[must_use]
+    pub fn tolerance(relative: f64) -> Self {
+        Self::Tolerance { relative, absolute: DEFAULT_ABSOLUTE * relative }
+    }
+
     /// The sample capacity the method needs (order², the kernel's `CAPACITIES`).
     #[must_use]
     pub fn capacity(&self) -> usize {
         match *self {
-            Self::Tolerance(_) => stack::capacity_for(ADAPTIVE_MAX_ORDER),
+            Self::Tolerance { .. } => stack::capacity_for(ADAPTIVE_MAX_ORDER),
             Self::Order { order, .. } => stack::capacity_for(order),
         }
     }
@@ -148,6 +169,10 @@ fn inside_solid(solid: &Geom, geom: &Geom, p: &ScenePatch, ball: (Vec3<f64>, f64
                     corners(origin, edge_t, edge_s, p.rect).map(|x| (x - center).norm()).fold(0.0, f64::max)
                 }
                 Geom::Disk { center: c, outer, .. } => (c - center).norm() + outer,
+                // A part of a sphere lies on it: within the whole sphere's reach, which is
+                // tighter than a part's ball (an octant's ball reaches 1.125 radii from its
+                // centre, 2.1 from the origin for a unit sphere's octant).
+                Geom::Sphere { center: c, radius: r, .. } => ((c - center).norm() + r).min((bc - center).norm() + br),
                 _ => (bc - center).norm() + br,
             };
             reach <= radius + tol
@@ -182,6 +207,8 @@ struct Context<'s, T> {
     /// Per surface, one occluder per piece (empty: the surface does not occlude).
     occluders: Vec<Vec<SceneOccluder<T>>>,
     info: Vec<PatchInfo<T>>,
+    /// Per surface (side): the summed area of its patches.
+    surface_areas: Vec<f64>,
     balls: Vec<(Vec3<f64>, f64)>,
     planes: Vec<Option<Plane>>,
     /// Per surface and piece: whether the radiating side may be concave, and the plane of a
@@ -344,11 +371,16 @@ impl<T: Real> Context<'_, T> {
         let (a, b) = (self.patch(i).map_err(wrap)?, self.patch(j).map_err(wrap)?);
         let start = Instant::now();
         let estimate = match method {
-            PairMethod::Tolerance(tolerance) => {
+            PairMethod::Tolerance { relative, absolute } => {
+                // This pair's share of the surface pair's absolute tolerance (on F_IJ and F_JI).
+                let (pi, pj) = (&self.scene.patches[i], &self.scene.patches[j]);
+                let (ai, aj) = (self.info[i].area.to_f64(), self.info[j].area.to_f64());
+                let larger = self.surface_areas[pi.surface].max(self.surface_areas[pj.surface]);
                 let settings = Adaptive {
-                    tolerance: T::from_f64(tolerance),
+                    tolerance: T::from_f64(relative),
                     max_order: ADAPTIVE_MAX_ORDER,
                     max_depth: stack::ADAPTIVE_MAX_DEPTH,
+                    absolute: T::from_f64(absolute * ai * aj / larger),
                 };
                 adaptive_exchange::<T, _, _, [SceneOccluder<T>], CAP>(&a, &b, settings, occluders.as_slice())
             }
@@ -474,6 +506,7 @@ fn compute_with<T: Real, const CAP: usize>(
         shapes,
         occluders,
         info: Vec::new(),
+        surface_areas: vec![0.0; scene.surfaces.len()],
         balls: Vec::new(),
         planes: Vec::new(),
         piece_concave,
@@ -489,6 +522,9 @@ fn compute_with<T: Real, const CAP: usize>(
         let area = patch.area(16).map_err(at(i))?;
         info.push(PatchInfo { ball: patch.enclosing_ball(), area });
         ctx.planes.push(scene.geom(p).plane());
+    }
+    for (p, x) in scene.patches.iter().zip(&info) {
+        ctx.surface_areas[p.surface] += x.area.to_f64();
     }
     ctx.balls = info.iter().map(|x| ball_f64(&x.ball)).collect();
     let scale = ctx.balls.iter().map(|(c, r)| c.max_abs() + r).fold(0.0, f64::max);

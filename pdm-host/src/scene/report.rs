@@ -52,6 +52,9 @@ pub struct Diagnostics {
     pub pairs_unconverged: usize,
     /// Largest relative error estimate of a nonzero patch entry.
     pub largest_relative_error: Option<f64>,
+    /// Largest error estimate of a surface-to-surface form factor F_IJ (absolute: what the
+    /// absolute tolerance bounds).
+    pub largest_absolute_error: Option<f64>,
     /// Largest |A_i F_ij − A_j F_ji| / max(A_i F_ij, A_j F_ji) over the surface matrix.
     pub largest_reciprocity_residual: f64,
     /// Surfaces whose row misses 1 by more than its error estimate (enclosures only).
@@ -104,7 +107,9 @@ pub fn patch_names(scene: &Scene) -> Vec<String> {
 
 fn describe(method: PairMethod) -> String {
     match method {
-        PairMethod::Tolerance(t) => format!("tolerance {t:e} per pair (adaptive_exchange)"),
+        PairMethod::Tolerance { relative, absolute } => {
+            format!("tolerance {relative:e} per pair or {absolute:e} on each surface factor (adaptive_exchange)")
+        }
         PairMethod::Order { order, singular_order } => {
             format!("order {order}, singular order {singular_order} (pair_exchange, no error estimate)")
         }
@@ -116,7 +121,7 @@ fn describe(method: PairMethod) -> String {
 pub fn assemble(scene: &Scene, result: &MatrixResult, method: PairMethod) -> SceneReport {
     let n = scene.patches.len();
     let m = scene.surfaces.len();
-    let has_errors = matches!(method, PairMethod::Tolerance(_));
+    let has_errors = matches!(method, PairMethod::Tolerance { .. });
     let mut exchange = vec![vec![0.0; n]; n];
     let mut error = vec![vec![0.0; n]; n];
     let mut s_exchange = vec![vec![0.0; m]; m];
@@ -173,6 +178,7 @@ pub fn assemble(scene: &Scene, result: &MatrixResult, method: PairMethod) -> Sce
             .map(|p| p.error.unwrap_or(0.0) / p.exchange)
             .fold(0.0, f64::max)
     });
+    let largest_absolute_error = surfaces.errors.as_ref().map(|e| e.iter().flatten().copied().fold(0.0, f64::max));
     let mut enclosure_gaps = Vec::new();
     if scene.enclosure {
         for i in 0..m {
@@ -222,6 +228,7 @@ pub fn assemble(scene: &Scene, result: &MatrixResult, method: PairMethod) -> Sce
         pairs_skipped: result.skipped,
         pairs_unconverged: unconverged,
         largest_relative_error,
+        largest_absolute_error,
         largest_reciprocity_residual: residual,
         enclosure_gaps,
         overfull_rows,
@@ -271,7 +278,9 @@ pub fn text(report: &SceneReport) -> String {
     );
     if let Some(e) = d.largest_relative_error {
         out += &format!(
-            "largest relative error estimate of an entry: {e:.1e}; pairs above the tolerance: {}\n",
+            "largest relative error estimate of an entry: {e:.1e}; largest estimate of a surface factor: {:.1e}; \
+             pairs above the tolerance: {}\n",
+            d.largest_absolute_error.unwrap_or(0.0),
             d.pairs_unconverged
         );
     }

@@ -137,6 +137,35 @@ pub fn bilinear(c: &[Vec3<f64>; 4], t: f64, s: f64) -> Vec3<f64> {
 
 /// Bounds [min, max] of a cos θ + b sin θ over θ ∈ [θ₀, θ₁] (exact: the ends and the
 /// stationary points inside).
+/// The control points of the cubic Bézier segment `c` (over [0, 1]) restricted to [a, b]: its
+/// blossom at (a, a, a), (a, a, b), (a, b, b), (b, b, b).
+fn cubic_sub_segment(c: [Vec3<f64>; 4], a: f64, b: f64) -> [Vec3<f64>; 4] {
+    let blossom = |u: [f64; 3]| {
+        let mut p = c;
+        for (level, &x) in u.iter().enumerate() {
+            for k in 0..3 - level {
+                p[k] = p[k].scale(1.0 - x) + p[k + 1].scale(x);
+            }
+        }
+        p[0]
+    };
+    [blossom([a, a, a]), blossom([a, a, b]), blossom([a, b, b]), blossom([b, b, b])]
+}
+
+/// The control net of the bicubic Bézier patch `control` (t along the first index, s along the
+/// second, as `pdm_kernel::BezierPatch`) over the sub-rectangle `r` of [0, 1]².
+fn bezier_sub_net(control: &[[Vec3<f64>; 4]; 4], r: Rect) -> [[Vec3<f64>; 4]; 4] {
+    let rows = control.map(|row| cubic_sub_segment(row, r.s0, r.s1));
+    let mut net = rows;
+    for j in 0..4 {
+        let column = cubic_sub_segment([rows[0][j], rows[1][j], rows[2][j], rows[3][j]], r.t0, r.t1);
+        for (i, p) in column.into_iter().enumerate() {
+            net[i][j] = p;
+        }
+    }
+    net
+}
+
 fn trig_range(a: f64, b: f64, t0: f64, t1: f64) -> (f64, f64) {
     let f = |t: f64| a * t.cos() + b * t.sin();
     let (mut lo, mut hi) = (f(t0).min(f(t1)), f(t0).max(f(t1)));
@@ -318,12 +347,13 @@ impl Geom {
                 }
                 range
             }
-            // The whole net: the convex hull of its control points holds the surface.
-            Self::Bezier { control } if rect == self.domain() => {
-                let d = control.iter().flatten().map(|p| plane.distance(*p));
+            // The net of the patch (the whole net, or the part over `rect` by blossoming): the
+            // convex hull of its control points holds the surface.
+            Self::Bezier { control } => {
+                let d = bezier_sub_net(&control, rect).into_iter().flatten().map(|p| plane.distance(p));
                 d.fold((f64::MAX, -f64::MAX), |(lo, hi), x| (lo.min(x), hi.max(x)))
             }
-            Self::Sphere { .. } | Self::Bezier { .. } => match self.shape::<f64>() {
+            Self::Sphere { .. } => match self.shape::<f64>() {
                 Ok(shape) => match Patch::new(&shape, rect) {
                     Ok(patch) => {
                         let ball = patch.enclosing_ball();
@@ -350,5 +380,55 @@ pub fn occluder_of<T: Real>(shape: &Shape<T>) -> Option<AnyOccluder<T>> {
         Shape::Cone(c) => Some(AnyOccluder::Cone(c)),
         Shape::Bezier(b) => Some(AnyOccluder::Bezier(b)),
         Shape::Quadrilateral(q) => Some(AnyOccluder::Quadrilateral(q)),
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+
+    fn dish() -> [[Vec3<f64>; 4]; 4] {
+        // A bowl, skewed so that no axis is special.
+        core::array::from_fn(|i| {
+            core::array::from_fn(|j| {
+                let (x, y) = (i as f64 / 3.0 - 0.5, j as f64 / 3.0 - 0.5);
+                vec3(x + 0.1 * y, y, 0.6 + x * x + 0.7 * y * y + 0.2 * x * y)
+            })
+        })
+    }
+
+    #[test]
+    fn a_bezier_sub_net_is_the_patch_over_its_rectangle() {
+        let control = dish();
+        let whole = BezierPatch::new(control).unwrap();
+        let r = Rect { t0: 0.25, t1: 0.75, s0: 0.5, s1: 0.875 };
+        let part = BezierPatch::new(bezier_sub_net(&control, r)).unwrap();
+        for (u, v) in [(0.0, 0.0), (1.0, 1.0), (0.3, 0.9), (0.5, 0.1), (1.0, 0.0)] {
+            let (t, s) = (r.t0 + u * (r.t1 - r.t0), r.s0 + v * (r.s1 - r.s0));
+            let (p, q) = (whole.point(t, s), part.point(u, v));
+            assert!((p - q).norm() < 1e-14, "({u}, {v}): {p:?} against {q:?}");
+        }
+    }
+
+    #[test]
+    fn a_bezier_cell_above_a_plane_is_bounded_by_its_own_net() {
+        // The cell's net is a tighter bound than a ball around the cell: a plane below the
+        // bowl's bottom that the ball of a wall cell would reach.
+        let geom = Geom::Bezier { control: dish() };
+        let plane = Plane { origin: vec3(0.0, 0.0, 0.55), normal: vec3(0.0, 0.0, 1.0) };
+        let r = Rect { t0: 0.5, t1: 1.0, s0: 0.5, s1: 1.0 };
+        let (lo, hi) = geom.distance_range(r, &plane);
+        let shape = BezierPatch::new(dish()).unwrap();
+        let (mut slo, mut shi) = (f64::MAX, -f64::MAX);
+        for k in 0..=20 {
+            for l in 0..=20 {
+                let p = shape.point(0.5 + k as f64 / 40.0, 0.5 + l as f64 / 40.0);
+                let d = plane.distance(p);
+                (slo, shi) = (slo.min(d), shi.max(d));
+            }
+        }
+        assert!(lo <= slo && shi <= hi, "[{lo}, {hi}] does not hold [{slo}, {shi}]");
+        assert!(lo > 0.0, "the cell lies above the plane: {lo}");
     }
 }

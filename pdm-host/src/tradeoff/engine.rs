@@ -151,6 +151,7 @@ where
                 tolerance: T::from_f64(tolerance),
                 max_order: ADAPTIVE_MAX_ORDER,
                 max_depth: ADAPTIVE_MAX_DEPTH,
+                absolute: T::ZERO,
             };
             (kernel::Method::Tolerance(settings), (ADAPTIVE_MAX_ORDER + 2) * (ADAPTIVE_MAX_ORDER + 2))
         }

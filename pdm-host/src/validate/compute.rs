@@ -203,6 +203,7 @@ fn method<T: Real>(cfg: &RunConfig) -> Method<T> {
             tolerance: T::from_f64(tol),
             max_order: ADAPTIVE_MAX_ORDER,
             max_depth: super::stack::ADAPTIVE_MAX_DEPTH,
+            absolute: T::ZERO,
         }),
         (Mode::Accurate, None) => {
             Method::Pair(PairSettings { order: cfg.order, singular_order: cfg.singular_order, boundaries: true })

@@ -32,7 +32,7 @@ where
     // Every edge pair in closed form: the value is the same at every order, its error the
     // rounding alone.
     if exact {
-        let estimate = Tally::leaf(lo, rounding, settings.tolerance, evaluations);
+        let estimate = Tally::leaf(lo, rounding, settings, evaluations);
         return Some(Ok((estimate, crate::bounds::lost_digits(lo, rounding))));
     }
     let mut order = 2 * lo_order;
@@ -42,7 +42,7 @@ where
             Err(e) => return Some(Err(e)),
         };
         evaluations = evaluations.saturating_add(n);
-        let estimate = Tally::leaf(hi, (hi - lo).abs() + rounding, settings.tolerance, evaluations);
+        let estimate = Tally::leaf(hi, (hi - lo).abs() + rounding, settings, evaluations);
         if estimate.converged || order >= crate::gauss::MAX_ORDER {
             return Some(Ok((estimate, crate::bounds::lost_digits(hi, rounding))));
         }
@@ -123,7 +123,7 @@ pub(super) fn algebraic_leaf<T: Real>(
         difference = difference.max((hi - v).abs());
         evaluations = evaluations.saturating_add(n);
     }
-    Ok(Tally::leaf(hi, T::from_f64(SAFETY) * difference, settings.tolerance, evaluations))
+    Ok(Tally::leaf(hi, T::from_f64(SAFETY) * difference, settings, evaluations))
 }
 
 /// How a pair that reaches `max_order` is subdivided.
@@ -184,7 +184,7 @@ where
         evaluations = evaluations.saturating_add(n);
         let difference = (next - prev).abs();
         let estimate = previous_difference.map_or(difference, |d1| difference.max((d1 * difference).sqrt()));
-        let leaf = Tally::leaf(next, estimate, settings.tolerance, evaluations);
+        let leaf = Tally::leaf(next, estimate, settings, evaluations);
         let accepted = leaf.converged && (how == Split::Larger || previous_difference.is_some());
         if accepted || (next_p + 2 > last_order && depth >= settings.max_depth) {
             return Ok(Tally { converged: accepted, ..leaf });

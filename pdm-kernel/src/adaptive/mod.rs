@@ -38,8 +38,9 @@
 //! safety factor where the convergence is only algebraic, plus a rounding allowance of
 //! 128 ε·|value| (2.8e-14 relative in f64, 1.5e-5 in f32); the total is the sum over the
 //! leaves. [`Estimate::converged`] is `true` if every leaf met the tolerance (estimate ≤
-//! tolerance·|value|, or value and estimate both zero) or the total estimate meets it against
-//! the total value; at the depth limit, or where a split would go below the resolution of the
+//! its share of the absolute budget + tolerance·|value|, or value and estimate both zero; the
+//! budget [`Adaptive::absolute`] is halved with each halving of a pair, so the leaves' shares
+//! add up to it) or the total estimate meets it against the total value; at the depth limit, or where a split would go below the resolution of the
 //! coordinates (f32 cells far from the origin), the best value is returned with its estimate
 //! and `converged = false` — never silently above the tolerance, and never an error after
 //! the work. A tolerance below 256 ε (5.7e-14
@@ -213,13 +214,33 @@ pub struct Adaptive<T> {
     pub max_order: usize,
     /// Largest number of successive subdivisions of a pair: ≤ [`MAX_DEPTH`].
     pub max_depth: u32,
+    /// Absolute error budget on the pair's exchange A_a·F_{a→b} (area units): finite and ≥ 0.
+    /// The result is converged when its estimate is at most `absolute + tolerance·|value|`.
+    /// [`Adaptive::new`] sets 0: relative only. A pair whose exchange is zero or tiny (a cell
+    /// that sees the other only past an occluder's rim, in a sliver) cannot meet a relative
+    /// tolerance: without a budget it is refined to `max_depth` whatever the cost. The budget is
+    /// shared out among the pieces a pair is split into (halves get half each, a 2 × 2 × 2 × 2
+    /// split a sixteenth), so the sum of the leaves' estimates meets it.
+    pub absolute: T,
 }
 
 impl<T: Real> Adaptive<T> {
     /// `tolerance` with max order 12 and max depth 6 (`CAP` ≥ 144).
     #[must_use]
     pub fn new(tolerance: T) -> Self {
-        Self { tolerance, max_order: 12, max_depth: 6 }
+        Self { tolerance, max_order: 12, max_depth: 6, absolute: T::ZERO }
+    }
+
+    /// The same settings with the absolute budget divided by `parts`: the share of each of
+    /// `parts` pieces of a pair.
+    pub(crate) fn share(self, parts: usize) -> Self {
+        Self { absolute: self.absolute / T::from_usize(parts.max(1)), ..self }
+    }
+
+    /// Whether `error` meets the tolerance against `value`: at most `absolute +
+    /// tolerance·|value|` (or below the smallest positive number: zero and zero).
+    pub(crate) fn met(&self, value: T, error: T) -> bool {
+        error <= self.absolute + self.tolerance * value.abs() || error <= T::MIN_POSITIVE
     }
 
     /// `Ok` if every setting is in range (module docs), `Err(InvalidSetting)` naming the first
@@ -233,6 +254,9 @@ impl<T: Real> Adaptive<T> {
         }
         if self.max_depth > MAX_DEPTH {
             return Err(PdmError::InvalidSetting { name: "max_depth", expected: "at most 24 (adaptive::MAX_DEPTH)" });
+        }
+        if !(self.absolute >= T::ZERO && self.absolute.is_finite()) {
+            return Err(PdmError::InvalidSetting { name: "absolute", expected: "finite and at least 0" });
         }
         Ok(())
     }
@@ -251,10 +275,10 @@ struct Tally<T> {
 
 impl<T: Real> Tally<T> {
     /// A leaf's estimate: `difference` (already scaled) plus the rounding allowance; converged
-    /// if within `tol`.
-    fn leaf(value: T, difference: T, tol: T, evaluations: u64) -> Self {
+    /// if it meets the settings' tolerance and budget ([`Adaptive::met`]).
+    fn leaf(value: T, difference: T, settings: Adaptive<T>, evaluations: u64) -> Self {
         let error = difference.abs() + T::from_f64(ROUNDING) * T::EPSILON * value.abs();
-        let converged = error <= tol * value.abs() || error <= T::MIN_POSITIVE;
+        let converged = settings.met(value, error);
         Self { value, error, converged, evaluations }
     }
 
@@ -315,12 +339,13 @@ where
     let work = Adaptive { tolerance: settings.tolerance.max(floor), ..settings };
     // Closed patches are cut at their seams first, as in `pair_exchange`.
     let mut e = Tally::zero(0);
+    let pieces = work.share(crate::pair::piece_pairs(a, b));
     crate::pair::for_each_piece_pair(a, b, |pa, pb| {
-        e.add(recurse::<T, SA, SB, O, CAP>(pa, pb, work, occluders, 0)?);
+        e.add(recurse::<T, SA, SB, O, CAP>(pa, pb, pieces, occluders, 0)?);
         Ok(())
     })?;
     e.error += backend_allowance::<T, SA, SB, CAP>(a, b)?;
-    e.converged &= e.error <= work.tolerance * e.value.abs() || e.error <= T::MIN_POSITIVE;
+    e.converged &= work.met(e.value, e.error);
     let (area_a, area_b) = (a.bounds_area(settings.max_order)?, b.bounds_area(settings.max_order)?);
     // The leaves are unchecked approximations: the total may overshoot [0, min(A_a, A_b)] by
     // its error, and is clamped there; beyond its error it is refused.
@@ -328,8 +353,8 @@ where
     // The leaves judge their own estimates against their own values; a leaf of a tiny value
     // may miss that while the total meets the tolerance asked for (the pieces of a whole disk
     // far from the other's rim): the sum of the estimates bounds the total's error.
-    e.converged |= e.error <= work.tolerance * e.value.abs();
-    e.converged &= work.tolerance == settings.tolerance || e.error <= settings.tolerance * e.value.abs();
+    e.converged |= work.met(e.value, e.error);
+    e.converged &= work.tolerance == settings.tolerance || settings.met(e.value, e.error);
     Ok(Estimate { value: e.value, error: Some(e.error), converged: e.converged, evaluations: e.evaluations })
 }
 
@@ -417,12 +442,12 @@ where
     SB: Surface<T> + ?Sized,
     O: Occluder<T> + ?Sized,
 {
-    let half = settings.tolerance * T::HALF;
+    let half = Adaptive { tolerance: settings.tolerance * T::HALF, ..settings.share(2) };
     let Some(part) = crate::boundary::Blocked::new(a, b, occluders)? else { return Ok(None) };
     let blocked = |order: usize| part.sum(order);
     let first = 4usize.min(settings.max_order);
     let Some((mut previous, mut evaluations)) = blocked(first)? else { return Ok(None) };
-    let unoccluded = recurse::<T, SA, SB, (), CAP>(a, b, Adaptive { tolerance: half, ..settings }, &(), 0)?;
+    let unoccluded = recurse::<T, SA, SB, (), CAP>(a, b, half, &(), 0)?;
     evaluations = evaluations.saturating_add(unoccluded.evaluations);
     let mut previous_difference: Option<T> = None;
     let mut order = first + 2;
@@ -433,7 +458,7 @@ where
         let estimate = previous_difference.map_or(difference, |d1| difference.max((d1 * difference).sqrt()))
             + T::from_f64(ROUNDING) * T::EPSILON * next.abs();
         let value = unoccluded.value - next;
-        if previous_difference.is_some() && (estimate <= half * value.abs() || estimate <= T::MIN_POSITIVE) {
+        if previous_difference.is_some() && half.met(value, estimate) {
             return Ok(Some(Tally {
                 value,
                 error: unoccluded.error + estimate,

@@ -145,7 +145,7 @@ where
     let difference = [best - whole, best - whole_next, best - quarters, quarters - whole, quarters - whole_next]
         .iter()
         .fold(T::ZERO, |m, d| m.max(d.abs()));
-    Ok(Tally::leaf(best, T::from_f64(SAFETY) * difference, settings.tolerance, evaluations))
+    Ok(Tally::leaf(best, T::from_f64(SAFETY) * difference, settings, evaluations))
 }
 
 /// A pair that a visibility boundary crosses. The boundaries are placed into the inner rule

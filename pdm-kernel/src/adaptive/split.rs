@@ -33,6 +33,7 @@ where
     O: Occluder<T> + ?Sized,
 {
     let mut total = Tally::zero(spent);
+    let settings = settings.share(16);
     let (ra, rb) = (a.rect(), b.rect());
     for k in 0..4 {
         let ca = Patch::new(a.surface(), ra.cell(k / 2, k % 2, 2, 2))?;
@@ -61,6 +62,7 @@ where
     O: Occluder<T> + ?Sized,
 {
     let mut total = Tally::zero(spent);
+    let settings = settings.share(2);
     let (la, lb) = (side_lengths(a), side_lengths(b));
     let split_a = la.0.max(la.1) >= lb.0.max(lb.1);
     for half in 0..2 {

@@ -31,6 +31,17 @@ where
     Ok(())
 }
 
+/// How many piece pairs [`for_each_piece_pair`] visits for `a` × `b`.
+pub(crate) fn piece_pairs<T, SA, SB>(a: &Patch<'_, T, SA>, b: &Patch<'_, T, SB>) -> usize
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+{
+    let ((ma, na), (mb, nb)) = (pieces(a), pieces(b));
+    ma * na * mb * nb
+}
+
 /// Into how many pieces (along t, along s) a patch is cut before integration: a direction in
 /// which the patch's image closes on itself, or nearly (the chord between its ends less than
 /// half the arc through its middle: the seam of a whole disk, cylinder, cone or sphere at

@@ -88,7 +88,7 @@ fn adaptive_against<T: Real, SA: Surface<T>, SB: Surface<T>>(
     reference: f64,
 ) -> Result<(f64, f64, f64), PdmError> {
     let (pa, pb) = (Patch::whole(a).unwrap(), Patch::whole(b).unwrap());
-    let settings = Adaptive { tolerance: T::from_f64(tolerance), max_order: 12, max_depth: depth };
+    let settings = Adaptive { tolerance: T::from_f64(tolerance), max_order: 12, max_depth: depth, absolute: T::ZERO };
     let result = adaptive_exchange::<T, _, _, _, 256>(&pa, &pb, settings, &());
     match &result {
         Ok(e) => println!(
