@@ -121,8 +121,7 @@ where
         }
         Method::Tolerance(s) => {
             // The absolute budget is the whole surface pair's: each patch pair gets its share.
-            let ((ma, na), (mb, nb)) = (a.dims(), b.dims());
-            let s = s.share(ma.saturating_mul(na).saturating_mul(mb).saturating_mul(nb));
+            let s = s.share(PatchGrid::count(&a).saturating_mul(PatchGrid::count(&b)));
             let pair = |pa: &Patch<'_, T, SA>, pb: &Patch<'_, T, SB>| {
                 adaptive_exchange::<T, SA, SB, O, CAP>(pa, pb, s, occluders).map(|e| (e, T::ZERO))
             };

@@ -40,8 +40,9 @@
 //! leaves. [`Estimate::converged`] is `true` if every leaf met the tolerance (estimate ≤
 //! its share of the absolute budget + tolerance·|value|, or value and estimate both zero; the
 //! budget [`Adaptive::absolute`] is halved with each halving of a pair, so the leaves' shares
-//! add up to it) or the total estimate meets it against the total value; at the depth limit, or where a split would go below the resolution of the
-//! coordinates (f32 cells far from the origin), the best value is returned with its estimate
+//! add up to it) or the total estimate meets it against the total value; at the depth limit,
+//! or where a split would go below the resolution of the coordinates (f32 cells far from the
+//! origin), the best value is returned with its estimate
 //! and `converged = false` — never silently above the tolerance, and never an error after
 //! the work. A tolerance below 256 ε (5.7e-14
 //! in f64, 3.1e-5 in f32) is below what any estimate can show: the refinement works to 256 ε

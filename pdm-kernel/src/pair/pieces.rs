@@ -15,11 +15,10 @@ where
     SA: Surface<T> + ?Sized,
     SB: Surface<T> + ?Sized,
 {
-    let (ma, na) = pieces(a);
-    let (mb, nb) = pieces(b);
-    if ma * na * mb * nb == 1 {
+    if piece_pairs(a, b) == 1 {
         return f(a, b);
     }
+    let ((ma, na), (mb, nb)) = (pieces(a), pieces(b));
     let (ra, rb) = (a.rect(), b.rect());
     for i in 0..ma * na {
         let pa = Patch::new(a.surface(), ra.cell(i / na, i % na, ma, na))?;
