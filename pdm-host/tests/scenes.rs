@@ -857,4 +857,7 @@ fn a_sphere_inside_a_sphere_sees_it_whole() {
     );
     let r = run(&s, PairMethod::tolerance(1e-6));
     check(&r, "inner", "outer", 1.0, 1e-6);
+    for row in &r.surfaces.factors {
+        assert!(row.iter().all(|f| (0.0..=1.0).contains(f)), "{:?}", r.surfaces.factors);
+    }
 }

@@ -60,6 +60,9 @@ impl<T: Real> Surface<T> for Shape<T> {
     fn convex_ball(&self) -> Option<pdm_kernel::Ball<T>> {
         each!(self, g => g.convex_ball())
     }
+    fn on_sphere(&self) -> Option<pdm_kernel::Ball<T>> {
+        each!(self, g => g.on_sphere())
+    }
     fn point_and_partials(&self, t: T, s: T) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {
         each!(self, g => g.point_and_partials(t, s))
     }

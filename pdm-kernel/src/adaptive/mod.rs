@@ -95,6 +95,11 @@
 //! * Self and edge pairs whose contact reaches a side collapsed to a point (a cone's apex)
 //!   converge only algebraically (`singular/`): the same five-order estimate as an
 //!   occluded self pair, not split (the cells at the apex stay algebraic at every level).
+//!   Where an occluder may cut such a pair, it is split 2 × 2 × 2 × 2 first, as any touching
+//!   pair an occluder may cut: the shadow then falls on separate sub-pairs, whose boundary
+//!   path places it, and the sub-pairs along the contact shrink until none can be cut (two
+//!   quarters of a sphere's inside sharing a meridian from the pole, a concentric sphere
+//!   inside: 7e-4 off as one algebraic leaf, 2e-8 split).
 //!
 //! # Settings
 //! `tolerance` must be positive and finite, `max_order` in 8..=[`MAX_ORDER`](crate::MAX_ORDER)
@@ -107,7 +112,7 @@
 
 use crate::error::PdmError;
 pub use crate::estimate::Estimate;
-use crate::pair::{route, ContactSplits, Route};
+use crate::pair::{route, Route};
 use crate::patch::Patch;
 use crate::real::Real;
 use crate::samples::PatchSamples;
@@ -394,8 +399,7 @@ where
             Some(result) => return result.map(|(estimate, _)| estimate),
         }
     }
-    let splits = ContactSplits { allowed: depth < settings.max_depth, collapsed: false };
-    match route(a, b, (adjacency, gap), occluders, splits) {
+    match route(a, b, (adjacency, gap), occluders, depth < settings.max_depth) {
         // The transforms test occlusion only at their nodes: with an occluder that may cut the
         // pair, successive orders can agree on a wrong value.
         Route::SplitContact => split_both::<T, SA, SB, O, CAP>(a, b, settings, occluders, depth, 0),

@@ -71,6 +71,7 @@ where
             affine: None,
             parallelogram: Some(self.map),
             trigonometric: false,
+            concentric: None,
             outline: None,
             line_rule: GaussRule::<T>::new(order.max(16))?,
             back_facets: match outer.affine_map() {

@@ -653,12 +653,23 @@ const MAX_TRIGONOMETRIC_S_BREAKS: usize = 8 * MAX_TRIGONOMETRIC_CURVES + 2;
 /// circles, a + b·cos φ + c(θ)·sin φ = 0 in its parameters, found in closed form like the
 /// conics above: along s where one crosses a t-edge or is tangent to the t-lines, along each
 /// t-line at its roots, every piece graded towards its breaks.
-pub(super) struct TrigonometricEvents<T> {
-    curves: [Trigonometric<T>; MAX_TRIGONOMETRIC_CURVES],
+///
+/// Generic over its capacity: `N` curves, `S` breaks in s and `TB` along a t-line (ends
+/// included); [`SphereCellEvents`] for these, `concentric::ConcentricEvents` for a pair across
+/// a concentric sphere occluder, whose curves are also plane sections of the outer sphere.
+pub(super) struct TrigonometricEvents<T, const N: usize, const S: usize, const TB: usize> {
+    curves: [Trigonometric<T>; N],
+    /// Whether the rule along a t-line is graded towards the curve's roots (a 3/2-power point
+    /// of J where a boundary touches an edge of b), per curve.
+    graded: [bool; N],
     n: usize,
 }
 
-impl<T: Real> TrigonometricEvents<T> {
+/// The events of a sphere's cell against a parallelogram ([`TrigonometricEvents::new`]).
+pub(super) type SphereCellEvents<T> =
+    TrigonometricEvents<T, MAX_TRIGONOMETRIC_CURVES, MAX_TRIGONOMETRIC_S_BREAKS, MAX_T_BREAKS>;
+
+impl<T: Real> SphereCellEvents<T> {
     /// The events of the curved outer surface against the parallelogram with affine map
     /// `inner` over `rect`; `None` if the surface does not give its facing tests in this form,
     /// a coefficient is not finite, or a curve's a or b varies with s.
@@ -670,23 +681,31 @@ impl<T: Real> TrigonometricEvents<T> {
         let (bo, bt, bs) = inner;
         let nb = bt.cross(bs);
         let unit = nb.scale(T::ONE / nb.norm());
-        let mut events = Self { curves: [[[T::ZERO; 3]; 3]; MAX_TRIGONOMETRIC_CURVES], n: 0 };
+        let mut events = Self::empty();
         let corner = |t: T, s: T| bo + bt.scale(t) + bs.scale(s);
         let corners =
             [corner(rect.t0, rect.s0), corner(rect.t1, rect.s0), corner(rect.t1, rect.s1), corner(rect.t0, rect.s1)];
         for c in corners {
             // The second test: the tangent plane at q passing through c.
             let [_, towards] = outer.facing_across_s(c, unit)?;
-            events.push(towards)?;
+            events.push(towards, false)?;
         }
         let [plane, _] = outer.facing_across_s(bo, unit)?;
-        events.push(plane)?;
+        events.push(plane, false)?;
         Some(events)
     }
+}
 
-    /// Keeps a curve scaled to its largest coefficient 1; `None` where it is not finite, its a
-    /// or b varies with s, or the buffer is full.
-    fn push(&mut self, curve: Trigonometric<T>) -> Option<()> {
+impl<T: Real, const N: usize, const S: usize, const TB: usize> TrigonometricEvents<T, N, S, TB> {
+    /// No curves yet.
+    pub(super) fn empty() -> Self {
+        Self { curves: [[[T::ZERO; 3]; 3]; N], graded: [false; N], n: 0 }
+    }
+
+    /// Keeps a curve scaled to its largest coefficient 1, with the rule along the t-lines
+    /// graded towards its roots where `graded`; `None` where it is not finite, its a or b
+    /// varies with s, or the buffer is full.
+    pub(super) fn push(&mut self, curve: Trigonometric<T>, graded: bool) -> Option<()> {
         let [a, b, _] = curve;
         let constant = |k: [T; 3]| k[1] == T::ZERO && k[2] == T::ZERO;
         if !curve.iter().flatten().all(|x| x.is_finite()) || !constant(a) || !constant(b) {
@@ -694,8 +713,8 @@ impl<T: Real> TrigonometricEvents<T> {
         }
         let largest = curve.iter().flatten().fold(T::ZERO, |m, x| m.max(x.abs()));
         let scaled = if largest > T::ZERO { curve.map(|k| k.map(|x| x / largest)) } else { curve };
-        let slot = self.curves.get_mut(self.n)?;
-        *slot = scaled;
+        *self.curves.get_mut(self.n)? = scaled;
+        *self.graded.get_mut(self.n)? = graded;
         self.n += 1;
         Some(())
     }
@@ -712,9 +731,9 @@ impl<T: Real> TrigonometricEvents<T> {
         rule: &GaussRule<T>,
         f: &mut dyn FnMut(T, T) -> Result<T, PdmError>,
     ) -> Result<T, PdmError> {
-        let mut breaks = [T::ZERO; MAX_TRIGONOMETRIC_S_BREAKS];
+        let mut breaks = [T::ZERO; S];
         let mut n = 0usize;
-        let mut tangencies = [T::ZERO; 2 * MAX_TRIGONOMETRIC_CURVES];
+        let mut tangencies = [T::ZERO; S];
         let mut nt = 0usize;
         let mut add = |x: T| place(x, r.s0, r.s1, &mut breaks, &mut n);
         add(r.s0);
@@ -752,18 +771,27 @@ impl<T: Real> TrigonometricEvents<T> {
         rule: &GaussRule<T>,
         f: &mut dyn FnMut(T, T) -> Result<T, PdmError>,
     ) -> Result<T, PdmError> {
-        let mut breaks = [T::ZERO; MAX_T_BREAKS];
+        let mut breaks = [T::ZERO; TB];
         let mut n = 0usize;
-        let mut add = |x: T| place(x, r.t0, r.t1, &mut breaks, &mut n);
-        add(r.t0);
+        let mut graded = [T::ZERO; TB];
+        let mut ng = 0usize;
+        place(r.t0, r.t0, r.t1, &mut breaks, &mut n);
         let (ss, cs) = s.sin_cos();
         let at = |k: [T; 3]| k[0] + k[1] * cs + k[2] * ss;
-        for &[a, b, c] in self.used() {
-            trigonometric_roots([at(a), at(b), at(c)], r.t0, r.t1, &mut add);
+        let flags = self.graded.get(..self.n).unwrap_or_default();
+        for (&[a, b, c], &grade) in self.used().iter().zip(flags) {
+            trigonometric_roots([at(a), at(b), at(c)], r.t0, r.t1, &mut |t| {
+                place(t, r.t0, r.t1, &mut breaks, &mut n);
+                if grade {
+                    place(t, r.t0, r.t1, &mut graded, &mut ng);
+                }
+            });
         }
-        add(r.t1);
-        // Its breaks are kinks with smooth sides (δ³ at a corner's circle, linear at the
-        // plane's): the plain rule on each piece, no grading.
-        sum_pieces(breaks.get_mut(..n).unwrap_or_default(), rule, &|_| false, &mut |t| f(t, s))
+        place(r.t1, r.t0, r.t1, &mut breaks, &mut n);
+        // Kinks with smooth sides (δ³ at a corner's circle, linear at a plane's, δ² where a
+        // boundary passes a corner) take the plain rule on each piece; the rule is graded
+        // towards the roots of the curves where a boundary touches an edge (δ^{3/2}).
+        let graded = graded.get(..ng).unwrap_or_default();
+        sum_pieces(breaks.get_mut(..n).unwrap_or_default(), rule, &|x| graded.contains(&x), &mut |t| f(t, s))
     }
 }

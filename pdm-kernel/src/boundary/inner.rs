@@ -21,9 +21,14 @@ pub(super) struct Inner<'x, T: Real, SB: Surface<T> + ?Sized, O: ?Sized> {
     #[cfg(feature = "closed-form")]
     pub(super) parallelogram: Option<(Vec3<T>, Vec3<T>, Vec3<T>)>,
     /// b's t-lines have trigonometric facing tests ([`Surface::facing_along_t`]) and no
-    /// occluder can cut: visibility along them in closed form.
+    /// occluder can cut, or only a sphere concentric with b's ([`Inner::concentric`]):
+    /// visibility along them in closed form.
     #[cfg(feature = "closed-form")]
     pub(super) trigonometric: bool,
+    /// The one occluder that may cut, where it is a sphere with the centre of b's sphere
+    /// (`concentric.rs`): its test on b is a plane's, trigonometric like the facing tests.
+    #[cfg(feature = "closed-form")]
+    pub(super) concentric: Option<Concentric<T>>,
     /// b's outline when b is flat but not a parallelogram (a disk or annulus sector, a planar
     /// Bézier patch): the point-to-region form along it.
     #[cfg(feature = "closed-form")]
@@ -132,8 +137,9 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
             }
             #[cfg(feature = "closed-form")]
             if self.trigonometric {
-                if let Some(fs) = self.surface.facing_along_t(s, p, np) {
-                    if trigonometric_line(&fs, r.t0, r.t1, &vis_at, candidates, line) {
+                if let Some((tests, n)) = self.line_tests(p, np, s) {
+                    let tests = tests.get(..n).unwrap_or_default();
+                    if trigonometric_line(tests, r.t0, r.t1, &vis_at, candidates, line) {
                         return Ok(());
                     }
                 }
@@ -148,6 +154,22 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
         let first_hi = line.breaks.get(1).copied().unwrap_or(r.t1);
         line.first_visible = vis_at((r.t0 + first_hi) * T::HALF);
         Ok(())
+    }
+
+    /// The tests along the t-line at s whose roots hold every visibility change from p
+    /// ([`Surface::facing_along_t`]): both facing tests, and the concentric occluder's plane
+    /// where there is one; `None` where the surface does not give them.
+    #[cfg(feature = "closed-form")]
+    fn line_tests(&self, p: Vec3<T>, np: Vec3<T>, s: T) -> Option<([[T; 3]; 3], usize)> {
+        let [f1, f2] = self.surface.facing_along_t(s, p, np)?;
+        match &self.concentric {
+            None => Some(([f1, f2, [T::ZERO; 3]], 2)),
+            Some(c) => {
+                let (x0, n) = c.plane(p)?;
+                let [f3, _] = self.surface.facing_along_t(s, x0, n)?;
+                Some(([f1, f2, f3], 3))
+            }
+        }
     }
 
     /// The structure of a line: (number of breakpoints, visibility of the first piece, which
@@ -349,7 +371,8 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
     }
 
     /// The s-breaks of a curved b whose facing tests are trigonometric in both parameters
-    /// ([`Surface::facing_across_s`]): for each test f = a(s) + b(s)·cos t + c(s)·sin t, where
+    /// ([`Surface::facing_across_s`]; with a concentric sphere occluder its plane's test too,
+    /// [`Inner::concentric`]): for each test f = a(s) + b(s)·cos t + c(s)·sin t, where
     /// its zero set crosses a t-edge (f(t_edge, s) = 0, first-degree in s) and, where a and b
     /// do not depend on s, where it is tangent to the t-lines (b² + c(s)² = a², i.e.
     /// c(s) = ±√(a² − b²)), all solved by [`trigonometric_roots`]. Roots just outside [s0, s1]
@@ -365,7 +388,16 @@ impl<T: Real, SB: Surface<T> + ?Sized, O: Occluder<T> + ?Sized> Inner<'_, T, SB,
         out: &mut [T; MAX_BREAKS + 2],
         n: &mut usize,
     ) -> Result<Option<Outside<T>>, PdmError> {
-        let Some(tests) = self.surface.facing_across_s(p, np) else { return Ok(None) };
+        let Some([f1, f2]) = self.surface.facing_across_s(p, np) else { return Ok(None) };
+        let zero = [[T::ZERO; 3]; 3];
+        let tests = match &self.concentric {
+            None => [f1, f2, zero],
+            Some(c) => {
+                let Some((x0, n)) = c.plane(p) else { return Ok(None) };
+                let Some([f3, _]) = self.surface.facing_across_s(x0, n) else { return Ok(None) };
+                [f1, f2, f3]
+            }
+        };
         let reach = (r.s1 - r.s0) * T::HALF * T::HALF;
         let (lo, hi) = (r.s0 - reach, r.s1 + reach);
         let mut roots = [T::ZERO; MAX_BREAKS];

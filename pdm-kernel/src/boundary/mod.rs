@@ -14,7 +14,8 @@
 //!   quadratics, each piece between roots classified by the exact test at its midpoint; when
 //!   b's t-lines are circles on which both facing tests are first-degree trigonometric
 //!   polynomials ([`Surface::facing_along_t`]: a sphere's meridians, a cylinder's or a cone's
-//!   circles) and no occluder can cut, the roots of those, in closed form, likewise; otherwise
+//!   circles) and no occluder can cut, or only a sphere with the centre of b's sphere (whose
+//!   test on b is a plane's, `concentric.rs`), the roots of those, in closed form, likewise; otherwise
 //!   bracketed on 2·order + 3 probes and bisected to machine precision. Each visible piece gets
 //!   its own Gauss rule.
 //! * **Along s**, the line integral is smooth except where the lines' visibility structure
@@ -53,7 +54,11 @@
 //! cuts goes outside with J(p) by the point-to-polygon form, whose only kinks are where a's
 //! tangent plane passes a corner of b and where a crosses b's plane: circles on a sphere, found
 //! in closed form (`events.rs`, [`TrigonometricEvents`]; sphere cells summed against a tilted
-//! rectangle against Ω/4π, same test file). Elsewhere the outer rule samples across
+//! rectangle against Ω/4π, same test file). A sphere's cell against a cell of a sphere with
+//! the same centre, across a sphere occluder with that centre or none, has only circles about
+//! the centre for boundaries: its events are plane sections of the outer sphere, placed the
+//! same way (`concentric.rs`; an octant's row inside a sphere around a concentric one against
+//! the closed form 1 − (r/R)², `tests/integration/tests/adaptive.rs`). Elsewhere the outer rule samples across
 //! them (algebraic convergence), which patch grids (and the outer split in [`crate::pair`])
 //! reduce.
 //!
@@ -116,6 +121,8 @@ use crate::visibility::Occluder;
 mod blocked;
 mod breaks;
 #[cfg(feature = "closed-form")]
+mod concentric;
+#[cfg(feature = "closed-form")]
 mod events;
 mod inner;
 mod lines;
@@ -126,6 +133,8 @@ mod shadows;
 #[cfg(feature = "closed-form")]
 pub(crate) use blocked::Blocked;
 use breaks::*;
+#[cfg(feature = "closed-form")]
+use concentric::*;
 #[cfg(feature = "closed-form")]
 use events::*;
 use inner::*;
@@ -230,6 +239,11 @@ where
         }
         None => false,
     };
+    #[cfg(feature = "closed-form")]
+    let concentric = match (affine, use_occluders) {
+        (None, true) => Concentric::of(surface, &inner_bounds, &a.enclosing_ball(), occluders),
+        _ => None,
+    };
     let inner = Inner {
         surface,
         r,
@@ -240,8 +254,10 @@ where
         parallelogram: affine,
         #[cfg(feature = "closed-form")]
         trigonometric: affine.is_none()
-            && !use_occluders
+            && (!use_occluders || concentric.is_some())
             && surface.facing_along_t(r.s0, Vec3::ZERO, vec3(T::ZERO, T::ZERO, T::ONE)).is_some(),
+        #[cfg(feature = "closed-form")]
+        concentric,
         #[cfg(feature = "closed-form")]
         outline: if affine.is_none() { crate::contour::Outline::new(b) } else { None },
         #[cfg(feature = "closed-form")]
@@ -302,6 +318,11 @@ where
     O: Occluder<T> + ?Sized,
 {
     let surface = a.surface();
+    if inner.concentric.is_some() || !inner.use_occluders {
+        if let Some(total) = concentric_sum(a, cells, inner, inner_samples, inner_bounds)? {
+            return Ok(Some(total));
+        }
+    }
     let events = match surface.affine_map() {
         Some(outer_map) => pair_events(
             outer_map,
@@ -325,6 +346,38 @@ where
             OuterEvents::Flat(e) => e.integrate(*cell, &inner.rule, &mut f)?,
             OuterEvents::Curved(e) => e.integrate(*cell, &inner.rule, &mut f)?,
         };
+    }
+    Ok(Some(total))
+}
+
+/// The outer integral over the cells of a sphere's cell a against a cell of a sphere with the
+/// same centre, across a sphere occluder concentric with both or none, with the events placed
+/// into the outer rule (`concentric.rs`); `None` where they are not available
+/// ([`concentric_events`]). In a frame of its own: the events take more room than the other
+/// kinds'.
+#[cfg(feature = "closed-form")]
+#[inline(never)]
+fn concentric_sum<T, SA, SB, O, const CB: usize>(
+    a: &Patch<'_, T, SA>,
+    cells: &[ParamRect<T>],
+    inner: &Inner<'_, T, SB, O>,
+    inner_samples: &PatchSamples<T, CB>,
+    inner_bounds: &Ball<T>,
+) -> Result<Option<T>, PdmError>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
+    let surface = a.surface();
+    let Some(events) = concentric_events(surface, inner.surface, inner.r, inner.concentric.as_ref()) else {
+        return Ok(None);
+    };
+    let mut f = |t: T, s: T| outer_integrand(surface, t, s, inner, inner_samples, inner_bounds);
+    let mut total = T::ZERO;
+    for cell in cells {
+        total += events.integrate(*cell, &inner.rule, &mut f)?;
     }
     Ok(Some(total))
 }
@@ -402,7 +455,7 @@ where
 #[cfg(feature = "closed-form")]
 enum OuterEvents<T> {
     Flat(QuadricEvents<T>),
-    Curved(TrigonometricEvents<T>),
+    Curved(SphereCellEvents<T>),
 }
 
 /// The outer events of a curved outer patch (`surface`) against a parallelogram inner patch
@@ -414,7 +467,7 @@ fn curved_outer_events<T, SA>(
     affine: Option<(Vec3<T>, Vec3<T>, Vec3<T>)>,
     r: ParamRect<T>,
     use_occluders: bool,
-) -> Option<TrigonometricEvents<T>>
+) -> Option<SphereCellEvents<T>>
 where
     T: Real,
     SA: Surface<T> + ?Sized,
@@ -501,7 +554,13 @@ where
             let inner_map = affine.filter(|_| use_occluders)?;
             polygon_events_state(outer_map, outer.rect(), inner_map, r, occluders, &bounds)
         }
-        None => curved_outer_events(outer.surface(), affine, r, use_occluders).map(|_| true),
+        None => curved_outer_events(outer.surface(), affine, r, use_occluders).map(|_| true).or_else(|| {
+            let concentric = match use_occluders {
+                true => Some(Concentric::of(surface, &bounds, &outer.enclosing_ball(), occluders)?),
+                false => None,
+            };
+            concentric_events(outer.surface(), surface, r, concentric.as_ref()).map(|_| true)
+        }),
     }
 }
 
@@ -950,6 +1009,7 @@ mod tests {
             affine: plate.affine_map(),
             parallelogram: plate.affine_map(),
             trigonometric: false,
+            concentric: None,
             outline: None,
             line_rule: GaussRule::<f64>::new(20).unwrap(),
             back_facets: BackFacets::none(),

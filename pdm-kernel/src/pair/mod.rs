@@ -342,9 +342,9 @@ where
             None => {}
         }
     }
-    let splits = ContactSplits { allowed: settings.boundaries && depth < MAX_CONTACT_SPLITS, collapsed: true };
+    let may_split = settings.boundaries && depth < MAX_CONTACT_SPLITS;
     let exact = |(v, c): (T, u64)| Some((v, c, T::ZERO));
-    match route(a, b, (adjacency, gap), occluders, splits) {
+    match route(a, b, (adjacency, gap), occluders, may_split) {
         Route::SplitContact => Ok(None),
         Route::Touching { adjacency, gap, .. } => {
             let count = crate::singular::touching_evaluations(adjacency, settings.singular_order);

@@ -34,25 +34,16 @@ pub(crate) enum Route<T> {
     ContactPastShadows,
 }
 
-/// When a touching pair that an occluder may cut is split ([`Route::SplitContact`]).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) struct ContactSplits {
-    /// The caller may split this pair further (its depth limit is not reached).
-    pub(crate) allowed: bool,
-    /// Also split where the contact reaches a collapsed side. The fixed-order mode does (its
-    /// splits are capped at `MAX_CONTACT_SPLITS`, and the cells away from the collapsed point
-    /// become exact); the tolerance mode does not (its estimate would split the cells at the
-    /// collapsed point, algebraic at every level, down to `max_depth`).
-    pub(crate) collapsed: bool,
-}
-
-/// The route of the pair (a, b) whose contact `classify_near` found (module docs).
+/// The route of the pair (a, b) whose contact `classify_near` found (module docs). `may_split`:
+/// the caller may split a touching pair that an occluder may cut ([`Route::SplitContact`]; its
+/// depth limit is not reached), also where the contact reaches a collapsed side: the cells away
+/// from the collapsed point are then clear of the occluder, and only those at it stay algebraic.
 pub(crate) fn route<T, SA, SB, O>(
     a: &Patch<'_, T, SA>,
     b: &Patch<'_, T, SB>,
     (adjacency, gap): (Adjacency, T),
     occluders: &O,
-    splits: ContactSplits,
+    may_split: bool,
 ) -> Route<T>
 where
     T: Real,
@@ -67,7 +58,7 @@ where
             // At any depth: the transforms' occlusion test per node is what this avoids.
             if may_cut && contact_across_shadows(a, b, occluders) {
                 Route::ContactPastShadows
-            } else if splits.allowed && (splits.collapsed || !collapsed) && may_cut {
+            } else if may_split && may_cut {
                 Route::SplitContact
             } else {
                 Route::Touching { adjacency, gap, collapsed }

@@ -201,6 +201,17 @@ pub trait Surface<T: Real> {
     fn convex_ball(&self) -> Option<Ball<T>> {
         None
     }
+    /// `Some(ball)` if every point of the surface lies on the sphere bounding `ball`, on either
+    /// side ([`Sphere`]), and its t- and s-lines are circles of that sphere (meridians and
+    /// parallels). Across a sphere occluder with the same centre, what a point p sees of such a
+    /// surface is bounded by circles about the ray from the centre through p, so that its
+    /// visibility along the lines and the pair's outer events are in closed form
+    /// (`boundary/`). Default: `None`.
+    #[cfg(feature = "closed-form")]
+    #[inline]
+    fn on_sphere(&self) -> Option<Ball<T>> {
+        None
+    }
 }
 
 impl<T: Real, S: Surface<T> + ?Sized> Surface<T> for &S {
@@ -243,6 +254,10 @@ impl<T: Real, S: Surface<T> + ?Sized> Surface<T> for &S {
     #[cfg(feature = "closed-form")]
     fn convex_ball(&self) -> Option<Ball<T>> {
         (**self).convex_ball()
+    }
+    #[cfg(feature = "closed-form")]
+    fn on_sphere(&self) -> Option<Ball<T>> {
+        (**self).on_sphere()
     }
 }
 
@@ -353,6 +368,11 @@ impl<T: Real, S: Surface<T>> Surface<T> for Flipped<S> {
     fn facing_across_s(&self, p: Vec3<T>, np: Vec3<T>) -> Option<[[[T; 3]; 3]; 2]> {
         let [f1, f2] = self.0.facing_across_s(p, np)?;
         Some([f1, f2.map(|k| k.map(|x| -x))])
+    }
+    /// The surface's: its points and lines do not change.
+    #[cfg(feature = "closed-form")]
+    fn on_sphere(&self) -> Option<Ball<T>> {
+        self.0.on_sphere()
     }
 }
 

@@ -153,6 +153,11 @@ impl<T: Real> Surface<T> for Sphere<T> {
     fn convex_ball(&self) -> Option<crate::vec3::Ball<T>> {
         (self.side == Side::Outer).then_some(crate::vec3::Ball { center: self.center, radius: self.radius })
     }
+    /// Its ball, either side: the t-lines are meridians, the s-lines parallels.
+    #[cfg(feature = "closed-form")]
+    fn on_sphere(&self) -> Option<crate::vec3::Ball<T>> {
+        Some(crate::vec3::Ball { center: self.center, radius: self.radius })
+    }
     /// A point p sees the sphere's cap (p − c)·x̂ > r (either side: the inside sees the rest);
     /// over a cell [φ₀, φ₁] × [θ₀, θ₁] that cap's outline passes through a corner x̂ᵢ where
     /// (p − c)·x̂ᵢ = r (a plane), and touches a parallel φᵢ or a meridian θᵢ on the envelope of

@@ -641,3 +641,42 @@ fn an_absolute_budget_stops_a_pair_whose_exchange_is_zero() {
     assert!(both.value <= budget, "zero by geometry, up to the occluder's flatness: {both:?}");
     assert!(both.evaluations * 4 < relative.evaluations, "{both:?} against {relative:?}");
 }
+
+/// A row inside a sphere of radius R around a concentric sphere of radius r (the enclosure of
+/// `concentric_spheres.toml`): every point of the outer sphere's inside sees the inner sphere
+/// in a cone that takes (r/R)² of its hemisphere, so a cell's row over the whole outer sphere
+/// is exactly 1 − (r/R)² (closed form; REFERENCES.md, concentric spheres, with reciprocity).
+/// The row of one octant over all eight: pairs across the inner sphere's shadow, whose
+/// boundaries on both cells are circles about the centre (the outer events in closed form),
+/// and pairs that share the meridian from the pole, which the occluder may cut. Each pair
+/// meets the tolerance, and the row is within the sum of the estimates of the closed form
+/// and within 1e-8 of it.
+#[test]
+fn an_octant_inside_a_sphere_around_a_concentric_sphere_sums_to_the_closed_form() {
+    for (small, big) in [(1.0, 2.0), (1.3, 2.1)] {
+        let inner = Sphere::new(vec3(0.0, 0.0, 0.0), small, Side::Outer).unwrap();
+        let outer = Sphere::new(vec3(0.0, 0.0, 0.0), big, Side::Inner).unwrap();
+        let quarter = |i: usize, j: usize| {
+            let h = PI / 2.0;
+            ParamRect::new(i as f64 * h, (i + 1) as f64 * h, j as f64 * h, (j + 1) as f64 * h).unwrap()
+        };
+        let a = Patch::new(&outer, quarter(0, 0)).unwrap();
+        let (mut row, mut estimate) = (0.0, 0.0);
+        for k in 0..8 {
+            let b = Patch::new(&outer, quarter(k / 4, k % 4)).unwrap();
+            let e = adaptive_exchange::<f64, _, _, _, 144>(&a, &b, Adaptive::new(1e-6), &inner).unwrap();
+            assert!(e.converged, "r = {small}, R = {big}, octant {k}: {e:?}");
+            row += e.value;
+            estimate += e.error.unwrap();
+        }
+        let area = PI * big * big / 2.0;
+        let exact = 1.0 - (small / big) * (small / big);
+        let (row, estimate) = (row / area, estimate / area);
+        eprintln!("r = {small}, R = {big}: row {row:.15} against {exact}, estimate {estimate:.1e}");
+        assert!(
+            (row - exact).abs() <= estimate,
+            "r = {small}, R = {big}: {row} against {exact}, estimate {estimate:e}"
+        );
+        assert!((row - exact).abs() <= 1e-8 * exact, "r = {small}, R = {big}: {row} against {exact}");
+    }
+}

@@ -1,0 +1,265 @@
+//! A sphere occluder concentric with the sphere the inner patch lies on (a sphere inside a
+//! sphere): what a point p sees of b is then bounded by circles about the ray from the centre
+//! through p, in closed form at both levels.
+//!
+//! With c the common centre, ρ the occluder's radius, d = |p − c| > ρ and R the radius of b's
+//! sphere (> ρ), the segment from p to a point q of b misses the occluder exactly where the
+//! angle ω at c between p and q is at most ψ = acos(ρ/d) + acos(ρ/R): in the plane of c, p, q
+//! the occluder is a disk, and the segment is tangent to it where it makes those angles at c on
+//! either side of the tangent point. So the occluder's test on b is the plane test
+//! p̂·(q − c) ≥ R·cos ψ (p̂ the unit vector from c to p), which on a sphere's lines is
+//! first-degree trigonometric like the facing tests ([`Surface::facing_along_t`]): the inner
+//! rule places it in closed form ([`Concentric::plane`]).
+//!
+//! Where the outer patch lies on a sphere with the same centre too (radius d), every boundary
+//! of the visible part of b is a circle ω = ψₖ about p̂: the occluder's ψ, and where a facing
+//! test changes sign inside b, cos ω = d/R (p's tangent plane) and cos ω = R/d (q's). J(p)
+//! changes its structure only where such a circle passes a corner of b (the visible area grows
+//! like δ² on one side: a kink) or touches one of b's edges (like δ^{3/2}), and b's edges are
+//! circles of its sphere (meridians and parallels, [`Surface::on_sphere`]), each the set
+//! x̂·e = cos α. Both are plane sections of a's sphere: the corner q̂ᵢ where p̂·q̂ᵢ = cos ψₖ,
+//! the edge where p̂·e = cos(ψₖ ± α) (two circles on a sphere touch where their centres are
+//! the sum or the difference of their radii apart). Those are circles in a's parameters
+//! ([`Surface::facing_across_s`] of the plane), placed into the outer rule as
+//! [`TrigonometricEvents`] places a sphere's circles against a parallelogram, with the rule
+//! graded towards the touching curves' breaks.
+
+use super::*;
+
+/// A sphere occluder with the centre of the sphere b lies on, inside it.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Concentric<T> {
+    center: Vec3<T>,
+    occluder: T,
+    radius: T,
+}
+
+impl<T: Real> Concentric<T> {
+    /// The concentric sphere occluder of a pair, where the only occluder that may cut segments
+    /// from the ball `from` to b (`bounds`) is a sphere with the centre of b's sphere
+    /// (`surface`), smaller than it; `None` elsewhere. (A point inside it has no plane:
+    /// [`Concentric::plane`].)
+    pub(super) fn of<SB, O>(surface: &SB, bounds: &Ball<T>, from: &Ball<T>, occluders: &O) -> Option<Self>
+    where
+        SB: Surface<T> + ?Sized,
+        O: Occluder<T> + ?Sized,
+    {
+        let sphere = surface.on_sphere()?;
+        let occluder = occluders.shadow_sphere(from, bounds)??;
+        let scale = sphere.radius + sphere.center.norm();
+        let same = (occluder.center - sphere.center).norm() <= T::from_f64(16.0) * T::EPSILON * scale;
+        let margin = T::GEOMETRY_TOLERANCE * sphere.radius;
+        let inside = occluder.radius + margin < sphere.radius;
+        (same && inside && occluder.radius > T::ZERO).then_some(Self {
+            center: sphere.center,
+            occluder: occluder.radius,
+            radius: sphere.radius,
+        })
+    }
+
+    /// cos ψ for a point at distance `d` from the centre (module docs): the largest angle at
+    /// the centre between it and a visible point of b.
+    fn cos_reach(&self, d: T) -> T {
+        let (x, y) = (self.occluder / d, self.occluder / self.radius);
+        x * y - ((T::ONE - x * x).max(T::ZERO) * (T::ONE - y * y).max(T::ZERO)).sqrt()
+    }
+
+    /// The occluder's test from p as a plane (x₀, n): q of b is visible past it exactly where
+    /// n·(q − x₀) ≥ 0. `None` where p is not outside the occluder.
+    pub(super) fn plane(&self, p: Vec3<T>) -> Option<(Vec3<T>, Vec3<T>)> {
+        let v = p - self.center;
+        let d = v.norm();
+        if !(d > self.occluder) {
+            return None;
+        }
+        let n = v.scale(T::ONE / d);
+        Some((self.center + n.scale(self.radius * self.cos_reach(d)), n))
+    }
+}
+
+/// Most event curves of a concentric pair: per boundary angle (the occluder's and one facing
+/// test's, [`angles`]) four corners and two circles for each of four edges.
+const MAX_CONCENTRIC_CURVES: usize = 2 * 12;
+
+/// The outer events of a concentric pair ([`TrigonometricEvents`] with room for its curves).
+pub(super) type ConcentricEvents<T> =
+    TrigonometricEvents<T, MAX_CONCENTRIC_CURVES, { 8 * MAX_CONCENTRIC_CURVES + 2 }, { 2 * MAX_CONCENTRIC_CURVES + 2 }>;
+
+/// cos ψₖ of the boundaries of the visible part of b's sphere (radius `rb`) from a point of
+/// a's (radius `ra`; module docs): the occluder's where there is one, and the facing tests'
+/// d/R and R/d where those are below 1 (at most one is); each `None` where it is no boundary.
+fn angles<T: Real>(occluder: Option<&Concentric<T>>, ra: T, rb: T) -> [Option<T>; 2] {
+    let open = |k: T| (k.abs() < T::ONE - T::from_f64(64.0) * T::EPSILON).then_some(k);
+    let facing = if ra < rb { ra / rb } else { rb / ra };
+    [occluder.and_then(|c| open(c.cos_reach(ra))), open(facing)]
+}
+
+/// The circle of b's sphere an edge of b lies on, as (e, cos α, sin α): x̂·e = cos α, through
+/// the edge's ends and middle, checked at its quarter. `Some(None)` for an edge collapsed to a
+/// point (a pole: its corner's curves cover it); `None` where the points do not give one
+/// circle of the sphere to within the geometry's tolerance.
+fn edge_circle<T: Real>(center: Vec3<T>, radius: T, points: [Vec3<T>; 4]) -> Option<Option<(Vec3<T>, T, T)>> {
+    let [q0, q1, q2, check] = points;
+    let reach = (q1 - q0).norm().max((q2 - q0).norm());
+    if reach <= T::from_f64(1024.0) * T::EPSILON * radius {
+        return Some(None);
+    }
+    let normal = (q1 - q0).cross(q2 - q0);
+    let length = normal.norm();
+    if !(length > T::ZERO) {
+        return None;
+    }
+    let e = normal.scale(T::ONE / length);
+    if !((check - q0).dot(e).abs() <= T::GEOMETRY_TOLERANCE * radius) {
+        return None;
+    }
+    let cos = ((q0 - center).dot(e) / radius).max(-T::ONE).min(T::ONE);
+    let sin = (T::ONE - cos * cos).max(T::ZERO).sqrt();
+    Some(Some((e, cos, sin)))
+}
+
+/// The outer events of the sphere cell `outer` against the sphere cell `inner` over `r` with
+/// the same centre, across the concentric `occluder` or none (module docs); `None` where
+/// either surface does not lie on a sphere, the spheres do not share the centre, the outer
+/// surface does not give its plane sections in trigonometric form, or an edge of b is not a
+/// circle of its sphere.
+pub(super) fn concentric_events<T, SA, SB>(
+    outer: &SA,
+    inner: &SB,
+    r: ParamRect<T>,
+    occluder: Option<&Concentric<T>>,
+) -> Option<ConcentricEvents<T>>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+{
+    let (ball, inner_ball) = (outer.on_sphere()?, inner.on_sphere()?);
+    let c = inner_ball.center;
+    let scale = ball.radius + inner_ball.radius + c.norm();
+    if !((ball.center - c).norm() <= T::from_f64(16.0) * T::EPSILON * scale) {
+        return None;
+    }
+    let ra = ball.radius;
+    if occluder.is_some_and(|o| !(o.occluder + T::GEOMETRY_TOLERANCE * ra < ra)) {
+        return None;
+    }
+    let mut events = ConcentricEvents::empty();
+    // The plane section p̂·e = k of a's sphere: e·(p − (c + ra·k·e)) = 0.
+    let mut section = |e: Vec3<T>, k: T, grade: bool| -> Option<()> {
+        let [curve, _] = outer.facing_across_s(c + e.scale(ra * k), e)?;
+        events.push(curve, grade)
+    };
+    let rb = inner_ball.radius;
+    let corners = [(r.t0, r.s0), (r.t1, r.s0), (r.t1, r.s1), (r.t0, r.s1)].map(|(t, s)| inner.point(t, s));
+    let (tm, sm) = ((r.t0 + r.t1) * T::HALF, (r.s0 + r.s1) * T::HALF);
+    let quarter = |a: T, b: T| a + (b - a) * T::HALF * T::HALF;
+    let edges = [
+        [
+            inner.point(r.t0, r.s0),
+            inner.point(r.t1, r.s0),
+            inner.point(tm, r.s0),
+            inner.point(quarter(r.t0, r.t1), r.s0),
+        ],
+        [
+            inner.point(r.t0, r.s1),
+            inner.point(r.t1, r.s1),
+            inner.point(tm, r.s1),
+            inner.point(quarter(r.t0, r.t1), r.s1),
+        ],
+        [
+            inner.point(r.t0, r.s0),
+            inner.point(r.t0, r.s1),
+            inner.point(r.t0, sm),
+            inner.point(r.t0, quarter(r.s0, r.s1)),
+        ],
+        [
+            inner.point(r.t1, r.s0),
+            inner.point(r.t1, r.s1),
+            inner.point(r.t1, sm),
+            inner.point(r.t1, quarter(r.s0, r.s1)),
+        ],
+    ];
+    let mut circles = [None; 4];
+    for (slot, edge) in circles.iter_mut().zip(edges) {
+        *slot = edge_circle(c, rb, edge)?;
+    }
+    for cos_psi in angles(occluder, ra, rb).into_iter().flatten() {
+        let sin_psi = (T::ONE - cos_psi * cos_psi).max(T::ZERO).sqrt();
+        for q in corners {
+            let v = q - c;
+            let n = v.norm();
+            if !(n > T::ZERO) {
+                return None;
+            }
+            section(v.scale(T::ONE / n), cos_psi, false)?;
+        }
+        for (e, cos_a, sin_a) in circles.iter().flatten() {
+            // cos(ψ ∓ α): the circles touch with their centres ψ + α or |ψ − α| apart.
+            section(*e, cos_psi * *cos_a - sin_psi * *sin_a, true)?;
+            section(*e, cos_psi * *cos_a + sin_psi * *sin_a, true)?;
+        }
+    }
+    Some(events)
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+    use crate::surface::{Side, Sphere};
+
+    /// The plane test from p agrees with the occluder's own segment test on b's sphere, from
+    /// points inside and outside that sphere, except within rounding of the boundary.
+    #[test]
+    fn the_plane_is_the_occluders_test() {
+        let center = vec3(0.1, -0.2, 0.3);
+        let occluder = Sphere::outer(center, 0.7).unwrap();
+        let shell = Sphere::new(center, 1.6, Side::Inner).unwrap();
+        let bounds = Ball { center, radius: 1.6 };
+        let from = Ball { center, radius: 2.5 };
+        let concentric = Concentric::of(&shell, &bounds, &from, &occluder).unwrap();
+        let (mut visible, mut hidden) = (0, 0);
+        for k in 0..40 {
+            let (u, v) = (0.37 * k as f64, 0.91 * k as f64);
+            let d = 0.75 + 0.045 * k as f64;
+            let p = center + vec3(u.sin() * v.cos(), u.sin() * v.sin(), u.cos()).scale(d);
+            let (x0, n) = concentric.plane(p).unwrap();
+            for i in 1..20 {
+                for j in 0..24 {
+                    let q = shell.point(i as f64 * 0.157, j as f64 * 0.2618);
+                    let test = n.dot(q - x0);
+                    if test.abs() <= 1e-9 {
+                        continue;
+                    }
+                    let blocked = occluder.blocks(p, q);
+                    assert_eq!(test > 0.0, !blocked, "p {p:?}, q {q:?}: plane {test:e}");
+                    if blocked {
+                        hidden += 1;
+                    } else {
+                        visible += 1;
+                    }
+                }
+            }
+        }
+        assert!(visible > 1000 && hidden > 1000, "{visible} visible, {hidden} hidden");
+        assert!(concentric.plane(center + vec3(0.5, 0.0, 0.0)).is_none(), "inside the occluder");
+    }
+
+    /// Two cells inside a sphere across a concentric sphere get their outer events; with the
+    /// occluder moved off the centre, or of the size of the shell, they do not.
+    #[test]
+    fn events_only_for_a_concentric_occluder() {
+        let center = vec3(1.0, 2.0, -0.5);
+        let shell = Sphere::new(center, 2.0, Side::Inner).unwrap();
+        let cell = |t0: f64, s0: f64| Patch::new(&shell, ParamRect::new(t0, t0 + 0.8, s0, s0 + 0.8).unwrap()).unwrap();
+        let (a, b) = (cell(0.9, 0.0), cell(1.1, 2.4));
+        let inside = Sphere::outer(center, 1.0).unwrap();
+        assert!(outer_events_apply(&a, &b, &inside));
+        assert!(outer_events_apply(&b, &a, &inside));
+        let moved = Sphere::outer(center + vec3(0.0, 0.0, 1e-3), 1.0).unwrap();
+        assert!(!outer_events_apply(&a, &b, &moved));
+        let whole = Sphere::outer(center, 2.0).unwrap();
+        assert!(!outer_events_apply(&a, &b, &whole));
+    }
+}
