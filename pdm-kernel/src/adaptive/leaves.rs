@@ -58,7 +58,8 @@ where
 /// integrand jump, and on a patch that faces itself in some directions and away in others (a
 /// saddle: `singular::faces_itself_mixed`) the facing test puts kinks in it: the convergence is
 /// algebraic, so the value at p = `max_order` is estimated as 2 × the largest difference from
-/// orders p − 1, p − 2, p − 3 and p/2 (module docs), not split.
+/// orders p − 1, p − 2, p − 3 and p/2 (module docs); where that misses the tolerance and an
+/// occluder may cut, the pair is split ([`split_where_cut`]).
 #[inline(never)]
 pub(super) fn identical<T, S, O, const CAP: usize>(
     a: &Patch<'_, T, S>,
@@ -76,7 +77,8 @@ where
         let eval = |p: usize| crate::singular::identical_unchecked(a, p, occluders);
         return by_order_doubling::<T, S, S, O, CAP>(a, a, settings, occluders, depth, eval, 4, Split::Both);
     }
-    algebraic_leaf(|p| crate::singular::identical_unchecked(a, p, occluders), settings)
+    let leaf = algebraic_leaf(|p| crate::singular::identical_unchecked(a, p, occluders), settings)?;
+    split_where_cut::<T, S, S, O, CAP>(a, a, leaf, settings, occluders, depth)
 }
 
 /// A self or edge pair whose contact reaches a side collapsed to a point (a cone's apex:

@@ -1,6 +1,8 @@
 //! A sphere occluder concentric with the sphere the inner patch lies on (a sphere inside a
-//! sphere): what a point p sees of b is then bounded by circles about the ray from the centre
-//! through p, in closed form at both levels.
+//! sphere): its shadow on b from a point p is bounded by a circle about the ray from the
+//! centre through p, in closed form along b's lines; where the outer patch lies on a sphere
+//! with the same centre too, every boundary is such a circle, and the outer events are in
+//! closed form as well.
 //!
 //! With c the common centre, ρ the occluder's radius, d = |p − c| > ρ and R the radius of b's
 //! sphere (> ρ), the segment from p to a point q of b misses the occluder exactly where the
@@ -9,20 +11,27 @@
 //! either side of the tangent point. So the occluder's test on b is the plane test
 //! p̂·(q − c) ≥ R·cos ψ (p̂ the unit vector from c to p), which on a sphere's lines is
 //! first-degree trigonometric like the facing tests ([`Surface::facing_along_t`]): the inner
-//! rule places it in closed form ([`Concentric::plane`]).
+//! rule places it in closed form ([`Concentric::plane`]). (Where p's own facing circle on b
+//! is not centred on p's ray — a flat outer patch, or a sphere with another centre — it can
+//! cross the occluder's inside b; the s-breaks do not place that crossing, and J converges
+//! algebraically in s there.)
 //!
 //! Where the outer patch lies on a sphere with the same centre too (radius d), every boundary
 //! of the visible part of b is a circle ω = ψₖ about p̂: the occluder's ψ, and where a facing
 //! test changes sign inside b, cos ω = d/R (p's tangent plane) and cos ω = R/d (q's). J(p)
 //! changes its structure only where such a circle passes a corner of b (the visible area grows
-//! like δ² on one side: a kink) or touches one of b's edges (like δ^{3/2}), and b's edges are
+//! like δ² on one side: a jump in the second derivative) or touches one of b's edges (like
+//! δ^{3/2}), and b's edges are
 //! circles of its sphere (meridians and parallels, [`Surface::on_sphere`]), each the set
 //! x̂·e = cos α. Both are plane sections of a's sphere: the corner q̂ᵢ where p̂·q̂ᵢ = cos ψₖ,
 //! the edge where p̂·e = cos(ψₖ ± α) (two circles on a sphere touch where their centres are
 //! the sum or the difference of their radii apart). Those are circles in a's parameters
 //! ([`Surface::facing_across_s`] of the plane), placed into the outer rule as
 //! [`TrigonometricEvents`] places a sphere's circles against a parallelogram, with the rule
-//! graded towards the touching curves' breaks.
+//! along the t-lines graded towards every curve's roots: a corner's curve touches the
+//! tangency curve of each edge through that corner (where the circle touches the edge at its
+//! end), and ungraded there the outer rule converged only like n⁻⁷ on a cell holding that
+//! point.
 
 use super::*;
 
@@ -95,22 +104,23 @@ fn angles<T: Real>(occluder: Option<&Concentric<T>>, ra: T, rb: T) -> [Option<T>
 }
 
 /// The circle of b's sphere an edge of b lies on, as (e, cos α, sin α): x̂·e = cos α, through
-/// the edge's ends and middle, checked at its quarter. `Some(None)` for an edge collapsed to a
+/// the edge's start, quarter and middle (`points`, then its end), checked at its end (an edge
+/// that is a whole parallel ends where it starts). `Some(None)` for an edge collapsed to a
 /// point (a pole: its corner's curves cover it); `None` where the points do not give one
 /// circle of the sphere to within the geometry's tolerance.
 fn edge_circle<T: Real>(center: Vec3<T>, radius: T, points: [Vec3<T>; 4]) -> Option<Option<(Vec3<T>, T, T)>> {
-    let [q0, q1, q2, check] = points;
-    let reach = (q1 - q0).norm().max((q2 - q0).norm());
+    let [q0, quarter, middle, end] = points;
+    let reach = (quarter - q0).norm().max((middle - q0).norm());
     if reach <= T::from_f64(1024.0) * T::EPSILON * radius {
         return Some(None);
     }
-    let normal = (q1 - q0).cross(q2 - q0);
+    let normal = (quarter - q0).cross(middle - q0);
     let length = normal.norm();
     if !(length > T::ZERO) {
         return None;
     }
     let e = normal.scale(T::ONE / length);
-    if !((check - q0).dot(e).abs() <= T::GEOMETRY_TOLERANCE * radius) {
+    if !((end - q0).dot(e).abs() <= T::GEOMETRY_TOLERANCE * radius) {
         return None;
     }
     let cos = ((q0 - center).dot(e) / radius).max(-T::ONE).min(T::ONE);
@@ -120,9 +130,9 @@ fn edge_circle<T: Real>(center: Vec3<T>, radius: T, points: [Vec3<T>; 4]) -> Opt
 
 /// The outer events of the sphere cell `outer` against the sphere cell `inner` over `r` with
 /// the same centre, across the concentric `occluder` or none (module docs); `None` where
-/// either surface does not lie on a sphere, the spheres do not share the centre, the outer
-/// surface does not give its plane sections in trigonometric form, or an edge of b is not a
-/// circle of its sphere.
+/// either surface does not lie on a sphere, the spheres do not share the centre, the occluder
+/// reaches a's sphere, the outer surface does not give its plane sections in trigonometric
+/// form, or an edge of b is not a circle of its sphere.
 pub(super) fn concentric_events<T, SA, SB>(
     outer: &SA,
     inner: &SB,
@@ -154,31 +164,12 @@ where
     let corners = [(r.t0, r.s0), (r.t1, r.s0), (r.t1, r.s1), (r.t0, r.s1)].map(|(t, s)| inner.point(t, s));
     let (tm, sm) = ((r.t0 + r.t1) * T::HALF, (r.s0 + r.s1) * T::HALF);
     let quarter = |a: T, b: T| a + (b - a) * T::HALF * T::HALF;
+    let (tq, sq) = (quarter(r.t0, r.t1), quarter(r.s0, r.s1));
     let edges = [
-        [
-            inner.point(r.t0, r.s0),
-            inner.point(r.t1, r.s0),
-            inner.point(tm, r.s0),
-            inner.point(quarter(r.t0, r.t1), r.s0),
-        ],
-        [
-            inner.point(r.t0, r.s1),
-            inner.point(r.t1, r.s1),
-            inner.point(tm, r.s1),
-            inner.point(quarter(r.t0, r.t1), r.s1),
-        ],
-        [
-            inner.point(r.t0, r.s0),
-            inner.point(r.t0, r.s1),
-            inner.point(r.t0, sm),
-            inner.point(r.t0, quarter(r.s0, r.s1)),
-        ],
-        [
-            inner.point(r.t1, r.s0),
-            inner.point(r.t1, r.s1),
-            inner.point(r.t1, sm),
-            inner.point(r.t1, quarter(r.s0, r.s1)),
-        ],
+        [inner.point(r.t0, r.s0), inner.point(tq, r.s0), inner.point(tm, r.s0), inner.point(r.t1, r.s0)],
+        [inner.point(r.t0, r.s1), inner.point(tq, r.s1), inner.point(tm, r.s1), inner.point(r.t1, r.s1)],
+        [inner.point(r.t0, r.s0), inner.point(r.t0, sq), inner.point(r.t0, sm), inner.point(r.t0, r.s1)],
+        [inner.point(r.t1, r.s0), inner.point(r.t1, sq), inner.point(r.t1, sm), inner.point(r.t1, r.s1)],
     ];
     let mut circles = [None; 4];
     for (slot, edge) in circles.iter_mut().zip(edges) {
@@ -192,7 +183,7 @@ where
             if !(n > T::ZERO) {
                 return None;
             }
-            section(v.scale(T::ONE / n), cos_psi, false)?;
+            section(v.scale(T::ONE / n), cos_psi, true)?;
         }
         for (e, cos_a, sin_a) in circles.iter().flatten() {
             // cos(ψ ∓ α): the circles touch with their centres ψ + α or |ψ − α| apart.

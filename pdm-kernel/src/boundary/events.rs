@@ -788,9 +788,10 @@ impl<T: Real, const N: usize, const S: usize, const TB: usize> TrigonometricEven
             });
         }
         place(r.t1, r.t0, r.t1, &mut breaks, &mut n);
-        // Kinks with smooth sides (δ³ at a corner's circle, linear at a plane's, δ² where a
-        // boundary passes a corner) take the plain rule on each piece; the rule is graded
-        // towards the roots of the curves where a boundary touches an edge (δ^{3/2}).
+        // Kinks with smooth sides (δ³ at a sphere cell's corner circle, linear at a plane's)
+        // take the plain rule on each piece; the rule is graded towards the roots of the curves
+        // pushed as graded (a concentric pair's: δ^{3/2} where a boundary touches an edge, and
+        // the corner curves that touch those at the edges' ends).
         let graded = graded.get(..ng).unwrap_or_default();
         sum_pieces(breaks.get_mut(..n).unwrap_or_default(), rule, &|x| graded.contains(&x), &mut |t| f(t, s))
     }

@@ -26,8 +26,10 @@
 //!   normal cones: `facing_settled`), that an occluder may cut, or whose patches are closer
 //!   than their size gets the visibility boundaries placed into the inner rule and the inner patch
 //!   refined towards each outer point (`boundary/`; when an occluder may cut, the outer
-//!   events are placed into the outer rule for two parallelograms across one sphere, and the
-//!   outer patch is split `OCCLUDED_OUTER_SPLIT`² otherwise); smooth, distant, unoccludable pairs
+//!   events are placed into the outer rule where `boundary::outer_events_apply` gives them —
+//!   two parallelograms across one sphere or flat convex occluders, cells of spheres with the
+//!   occluding sphere's centre — and the outer patch is split `OCCLUDED_OUTER_SPLIT`²
+//!   otherwise); smooth, distant, unoccludable pairs
 //!   keep the plain sum. Without occluders the outer patch is, for a very near pair with one
 //!   flat patch, the curved one; otherwise the one with fewer points that see none of the
 //!   other, then the one whose points stay farther from the other's edges (`outer_is_b`).
@@ -393,9 +395,10 @@ where
 
 /// A separate pair: the plain sum where the integrand is smooth, else the boundary path. Where
 /// an occluder may cut, shadow edges crossing the inner patch make the outer integrand kink
-/// where they touch its edges: two parallelograms across one sphere get those curves placed
-/// into the outer rule (`boundary/`, outer events), other pairs the outer patch split
-/// `OCCLUDED_OUTER_SPLIT`².
+/// where they touch its edges: where `boundary::outer_events_apply` gives those curves (two
+/// parallelograms across one sphere or flat convex occluders, cells of spheres with the
+/// occluding sphere's centre) they are placed into the outer rule, elsewhere the outer patch
+/// is split `OCCLUDED_OUTER_SPLIT`².
 fn separate<T, SA, SB, O, const CAP: usize>(
     pair: &mut PairContext<'_, '_, T, SA, SB, O, CAP>,
     settings: PairSettings,

@@ -203,9 +203,10 @@ pub trait Surface<T: Real> {
     }
     /// `Some(ball)` if every point of the surface lies on the sphere bounding `ball`, on either
     /// side ([`Sphere`]), and its t- and s-lines are circles of that sphere (meridians and
-    /// parallels). Across a sphere occluder with the same centre, what a point p sees of such a
-    /// surface is bounded by circles about the ray from the centre through p, so that its
-    /// visibility along the lines and the pair's outer events are in closed form
+    /// parallels). Across a sphere occluder with the same centre, its shadow on such a surface
+    /// from a point p is bounded by a circle about the ray from the centre through p, so that
+    /// its test along the lines is in closed form; where p lies on such a surface too, every
+    /// boundary of what p sees is such a circle, and the pair's outer events are in closed form
     /// (`boundary/`). Default: `None`.
     #[cfg(feature = "closed-form")]
     #[inline]

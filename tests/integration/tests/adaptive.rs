@@ -646,30 +646,32 @@ fn an_absolute_budget_stops_a_pair_whose_exchange_is_zero() {
 /// `concentric_spheres.toml`): every point of the outer sphere's inside sees the inner sphere
 /// in a cone that takes (r/R)² of its hemisphere, so a cell's row over the whole outer sphere
 /// is exactly 1 − (r/R)² (closed form; REFERENCES.md, concentric spheres, with reciprocity).
-/// The row of one octant over all eight: pairs across the inner sphere's shadow, whose
-/// boundaries on both cells are circles about the centre (the outer events in closed form),
-/// and pairs that share the meridian from the pole, which the occluder may cut. Each pair
-/// meets the tolerance, and the row is within the sum of the estimates of the closed form
-/// and within 1e-8 of it.
+/// The row of the cell at the pole over every cell of an m × n grid: pairs across the inner
+/// sphere's shadow, whose boundaries on both cells are circles about the centre (the outer
+/// events in closed form), pairs that share the pole or a meridian from it, which the
+/// occluder may cut, and with r/R = 0.75 on 2 × 6 cells (each from the pole to the equator,
+/// 90° across, beyond the 82.8° the inner sphere leaves in view) the cell against itself
+/// across the shadow. Each pair meets the tolerance, and the row is within the sum of the
+/// estimates of the closed form and within 1e-8 of it.
 #[test]
-fn an_octant_inside_a_sphere_around_a_concentric_sphere_sums_to_the_closed_form() {
-    for (small, big) in [(1.0, 2.0), (1.3, 2.1)] {
+fn a_cell_inside_a_sphere_around_a_concentric_sphere_sums_to_the_closed_form() {
+    for (small, big, rows, columns) in [(1.0, 2.0, 2, 4), (1.3, 2.1, 2, 4), (1.5, 2.0, 2, 6)] {
         let inner = Sphere::new(vec3(0.0, 0.0, 0.0), small, Side::Outer).unwrap();
         let outer = Sphere::new(vec3(0.0, 0.0, 0.0), big, Side::Inner).unwrap();
-        let quarter = |i: usize, j: usize| {
-            let h = PI / 2.0;
-            ParamRect::new(i as f64 * h, (i + 1) as f64 * h, j as f64 * h, (j + 1) as f64 * h).unwrap()
+        let cell = |i: usize, j: usize| {
+            let (ht, hs) = (PI / rows as f64, 2.0 * PI / columns as f64);
+            ParamRect::new(i as f64 * ht, (i + 1) as f64 * ht, j as f64 * hs, (j + 1) as f64 * hs).unwrap()
         };
-        let a = Patch::new(&outer, quarter(0, 0)).unwrap();
+        let a = Patch::new(&outer, cell(0, 0)).unwrap();
         let (mut row, mut estimate) = (0.0, 0.0);
-        for k in 0..8 {
-            let b = Patch::new(&outer, quarter(k / 4, k % 4)).unwrap();
+        for k in 0..rows * columns {
+            let b = Patch::new(&outer, cell(k / columns, k % columns)).unwrap();
             let e = adaptive_exchange::<f64, _, _, _, 144>(&a, &b, Adaptive::new(1e-6), &inner).unwrap();
-            assert!(e.converged, "r = {small}, R = {big}, octant {k}: {e:?}");
+            assert!(e.converged, "r = {small}, R = {big}, cell {k}: {e:?}");
             row += e.value;
             estimate += e.error.unwrap();
         }
-        let area = PI * big * big / 2.0;
+        let area = 4.0 * PI * big * big / (rows * columns) as f64;
         let exact = 1.0 - (small / big) * (small / big);
         let (row, estimate) = (row / area, estimate / area);
         eprintln!("r = {small}, R = {big}: row {row:.15} against {exact}, estimate {estimate:.1e}");
