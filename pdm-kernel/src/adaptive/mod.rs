@@ -97,13 +97,13 @@
 //!
 //! * Self and edge pairs whose contact reaches a side collapsed to a point (a cone's apex)
 //!   converge only algebraically (`singular/`): the same five-order estimate as an
-//!   occluded self pair, not split (the cells at the apex stay algebraic at every level),
-//!   except a self pair that an occluder may cut, split as above.
-//!   Where an occluder may cut such a pair, it is split 2 × 2 × 2 × 2 first, as any touching
-//!   pair an occluder may cut: the shadow then falls on separate sub-pairs, whose boundary
-//!   path places it, and the sub-pairs along the contact shrink until none can be cut (two
-//!   quarters of a sphere's inside sharing a meridian from the pole, a concentric sphere
-//!   inside: 7e-4 off as one algebraic leaf, 2e-8 split).
+//!   occluded self pair, not split where no occluder may cut (the cells at the apex stay
+//!   algebraic at every level). Where one may, an edge pair is split 2 × 2 × 2 × 2 first, as
+//!   any touching pair an occluder may cut: the shadow then falls on separate sub-pairs, whose
+//!   boundary path places it, and the sub-pairs along the contact shrink until none can be
+//!   cut (two quarters of a sphere's inside sharing a meridian from the pole, a concentric
+//!   sphere inside: 7e-4 off as one algebraic leaf, 2e-8 split); a self pair is split as
+//!   above where its leaf misses the tolerance.
 //!
 //! # Settings
 //! `tolerance` must be positive and finite, `max_order` in 8..=[`MAX_ORDER`](crate::MAX_ORDER)

@@ -55,11 +55,9 @@ impl<T: Real> Concentric<T> {
     {
         let sphere = surface.on_sphere()?;
         let occluder = occluders.shadow_sphere(from, bounds)??;
-        let scale = sphere.radius + sphere.center.norm();
-        let same = (occluder.center - sphere.center).norm() <= T::from_f64(16.0) * T::EPSILON * scale;
         let margin = T::GEOMETRY_TOLERANCE * sphere.radius;
         let inside = occluder.radius + margin < sphere.radius;
-        (same && inside && occluder.radius > T::ZERO).then_some(Self {
+        (same_centre(&occluder, &sphere) && inside && occluder.radius > T::ZERO).then_some(Self {
             center: sphere.center,
             occluder: occluder.radius,
             radius: sphere.radius,
@@ -84,6 +82,13 @@ impl<T: Real> Concentric<T> {
         let n = v.scale(T::ONE / d);
         Some((self.center + n.scale(self.radius * self.cos_reach(d)), n))
     }
+}
+
+/// Whether two spheres share their centre to within rounding of their size and position: the
+/// plane tests and events hold only for a common centre.
+fn same_centre<T: Real>(a: &Ball<T>, b: &Ball<T>) -> bool {
+    let scale = a.radius + b.radius + a.center.norm();
+    (a.center - b.center).norm() <= T::from_f64(16.0) * T::EPSILON * scale
 }
 
 /// Most event curves of a concentric pair: per boundary angle (the occluder's and one facing
@@ -146,8 +151,7 @@ where
 {
     let (ball, inner_ball) = (outer.on_sphere()?, inner.on_sphere()?);
     let c = inner_ball.center;
-    let scale = ball.radius + inner_ball.radius + c.norm();
-    if !((ball.center - c).norm() <= T::from_f64(16.0) * T::EPSILON * scale) {
+    if !same_centre(&ball, &inner_ball) {
         return None;
     }
     let ra = ball.radius;

@@ -36,8 +36,10 @@ pub(crate) enum Route<T> {
 
 /// The route of the pair (a, b) whose contact `classify_near` found (module docs). `may_split`:
 /// the caller may split a touching pair that an occluder may cut ([`Route::SplitContact`]; its
-/// depth limit is not reached), also where the contact reaches a collapsed side: the cells away
-/// from the collapsed point are then clear of the occluder, and only those at it stay algebraic.
+/// depth limit is not reached), also where the contact reaches a collapsed side: where the
+/// occluder keeps away from the collapsed point, the cells along the contact shrink until it
+/// cannot cut them, and only those at the point stay algebraic (one that reaches the point
+/// leaves a chain of sub-pairs there split to the depth limit, 16 per level).
 pub(crate) fn route<T, SA, SB, O>(
     a: &Patch<'_, T, SA>,
     b: &Patch<'_, T, SB>,
