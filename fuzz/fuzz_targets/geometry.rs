@@ -19,7 +19,7 @@
 
 use arbitrary::Arbitrary;
 use libfuzzer_sys::fuzz_target;
-use pdm_kernel::{adaptive_exchange, form_factor_between, pair_exchange, self_form_factor, surface_form_factor, vec3, AnyOccluder, BezierPatch, Cone, Cylinder, Disk, Frame, PairSettings, Adaptive, Parallelogram, ParamRect, Patch, PatchGrid, PdmError, Quadrature, Real, Side, Sphere, Surface, Vec3};
+use pdm_kernel::{adaptive_exchange, Ball, Quadric, form_factor_between, pair_exchange, self_form_factor, surface_form_factor, vec3, AnyOccluder, BezierPatch, Cone, Cylinder, Disk, Frame, PairSettings, Adaptive, Parallelogram, ParamRect, Patch, PatchGrid, PdmError, Quadrature, Real, Side, Sphere, Surface, Vec3};
 use pdm_kernel::internals::{classify, classify_near, touching_exchange, Adjacency, SquareMap};
 
 /// Sample capacity: (order + 1)² for order ≤ 6 (the self integral uses order + 1).
@@ -200,6 +200,32 @@ impl<T: Real> Surface<T> for Shape<T> {
     }
     fn point_and_normal(&self, t: T, s: T) -> (Vec3<T>, Vec3<T>) {
         each!(self, x => x.point_and_normal(t, s))
+    }
+    // Every closed-form hook forwarded, so that inputs reach the closed-form paths (the contour
+    // form, the trigonometric inner rule, the outer events) as the built-ins do.
+    fn affine_map(&self) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {
+        each!(self, x => x.affine_map())
+    }
+    fn point_and_partials(&self, t: T, s: T) -> Option<(Vec3<T>, Vec3<T>, Vec3<T>)> {
+        each!(self, x => x.point_and_partials(t, s))
+    }
+    fn straight_corners(&self, rect: ParamRect<T>) -> Option<[Vec3<T>; 4]> {
+        each!(self, x => x.straight_corners(rect))
+    }
+    fn facing_along_t(&self, s: T, p: Vec3<T>, np: Vec3<T>) -> Option<[[T; 3]; 2]> {
+        each!(self, x => x.facing_along_t(s, p, np))
+    }
+    fn facing_across_s(&self, p: Vec3<T>, np: Vec3<T>) -> Option<[[[T; 3]; 3]; 2]> {
+        each!(self, x => x.facing_across_s(p, np))
+    }
+    fn event_quadrics(&self, rect: ParamRect<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
+        each!(self, x => x.event_quadrics(rect, out))
+    }
+    fn convex_ball(&self) -> Option<Ball<T>> {
+        each!(self, x => x.convex_ball())
+    }
+    fn on_sphere(&self) -> Option<Ball<T>> {
+        each!(self, x => x.on_sphere())
     }
 }
 

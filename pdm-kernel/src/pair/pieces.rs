@@ -2,9 +2,15 @@
 //! pieces, every pair of pieces dispatched on its own.
 
 use super::*;
+use crate::singular::{adjacency_tolerance, corner_points};
+use crate::surface::ParamRect;
 
 /// Calls `f` on every pair of pieces of a and b (see [`pieces`]): the pair methods then see
-/// only patches whose four corners are distinct unless an edge collapses to a point.
+/// only patches whose four corners are distinct unless an edge collapses to a point. A piece
+/// pair is cut further where the pair methods would meet a contact they have no transform for
+/// ([`contact_cuts`]): two patches on one map whose parameter rectangles overlap, or a corner
+/// of one lying on an edge of the other (a T-junction: a disk's sector against a cylinder
+/// wall's cell whose edges span other angles, two cells across a closed surface's seam).
 pub(crate) fn for_each_piece_pair<'s, 'r, T, SA, SB>(
     a: &Patch<'s, T, SA>,
     b: &Patch<'r, T, SB>,
@@ -15,16 +21,23 @@ where
     SA: Surface<T> + ?Sized,
     SB: Surface<T> + ?Sized,
 {
-    if piece_pairs(a, b) == 1 {
-        return f(a, b);
-    }
     let ((ma, na), (mb, nb)) = (pieces(a), pieces(b));
     let (ra, rb) = (a.rect(), b.rect());
     for i in 0..ma * na {
         let pa = Patch::new(a.surface(), ra.cell(i / na, i % na, ma, na))?;
         for j in 0..mb * nb {
             let pb = Patch::new(b.surface(), rb.cell(j / nb, j % nb, mb, nb))?;
-            f(&pa, &pb)?;
+            match contact_cuts(&pa, &pb) {
+                None => f(&pa, &pb)?,
+                Some((ca, cb)) => {
+                    for x in ca.rects() {
+                        let xa = Patch::new(pa.surface(), x)?;
+                        for y in cb.rects() {
+                            f(&xa, &Patch::new(pb.surface(), y)?)?;
+                        }
+                    }
+                }
+            }
         }
     }
     Ok(())
@@ -38,7 +51,249 @@ where
     SB: Surface<T> + ?Sized,
 {
     let ((ma, na), (mb, nb)) = (pieces(a), pieces(b));
-    ma * na * mb * nb
+    let (ra, rb) = (a.rect(), b.rect());
+    let mut count = 0usize;
+    for i in 0..ma * na {
+        let Ok(pa) = Patch::new(a.surface(), ra.cell(i / na, i % na, ma, na)) else {
+            return ma * na * mb * nb;
+        };
+        for j in 0..mb * nb {
+            let Ok(pb) = Patch::new(b.surface(), rb.cell(j / nb, j % nb, mb, nb)) else {
+                return ma * na * mb * nb;
+            };
+            count += contact_cuts(&pa, &pb).map_or(1, |(ca, cb)| ca.count() * cb.count());
+        }
+    }
+    count
+}
+
+/// Most cuts along one parameter of one patch (two from an overlap, four from corners on
+/// edges).
+const MAX_CUTS: usize = 6;
+
+/// A cut closer to a bound than this fraction of the parameter range is not made: the sliver
+/// it would leave is thinner than the touching transforms are tested for (aspect 1e4), and a
+/// contact that near a corner is left to `classify_near`.
+const MIN_CUT: f64 = 1e-4;
+
+/// A parameter rectangle cut along each parameter: its bounds in increasing order, `nt` along
+/// t and `ns` along s (the ends included).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Cuts<T> {
+    t: [T; MAX_CUTS + 2],
+    nt: usize,
+    s: [T; MAX_CUTS + 2],
+    ns: usize,
+}
+
+impl<T: Real> Cuts<T> {
+    fn new(r: ParamRect<T>) -> Self {
+        Self {
+            t: [r.t0, r.t1, r.t1, r.t1, r.t1, r.t1, r.t1, r.t1],
+            nt: 2,
+            s: [r.s0, r.s1, r.s1, r.s1, r.s1, r.s1, r.s1, r.s1],
+            ns: 2,
+        }
+    }
+
+    /// Inserts `x` among the bounds `v[..n]` if it lies inside them, farther than `MIN_CUT` of
+    /// the range from every bound, and there is room.
+    fn insert(v: &mut [T; MAX_CUTS + 2], n: &mut usize, x: T) {
+        let (Some(&lo), Some(&hi)) = (v.first(), v.get(n.saturating_sub(1))) else { return };
+        let gap = (hi - lo) * T::from_f64(MIN_CUT);
+        if *n >= v.len() || !(x > lo + gap && x < hi - gap) {
+            return;
+        }
+        let k = v.iter().take(*n).position(|&b| b >= x).unwrap_or(*n);
+        let near = |i: usize| v.get(i).is_some_and(|&b| (b - x).abs() <= gap);
+        if k == 0 || near(k) || near(k - 1) {
+            return;
+        }
+        let mut i = *n;
+        while i > k {
+            if let (Some(&prev), true) = (v.get(i - 1), i < v.len()) {
+                if let Some(slot) = v.get_mut(i) {
+                    *slot = prev;
+                }
+            }
+            i -= 1;
+        }
+        if let Some(slot) = v.get_mut(k) {
+            *slot = x;
+        }
+        *n += 1;
+    }
+
+    fn cut_t(&mut self, x: T) {
+        Self::insert(&mut self.t, &mut self.nt, x);
+    }
+
+    fn cut_s(&mut self, x: T) {
+        Self::insert(&mut self.s, &mut self.ns, x);
+    }
+
+    fn count(&self) -> usize {
+        (self.nt - 1) * (self.ns - 1)
+    }
+
+    fn rects(self) -> impl Iterator<Item = ParamRect<T>> {
+        let m = self.ns - 1;
+        (0..self.count()).map(move |k| {
+            let (i, j) = (k / m, k % m);
+            let at = |v: &[T; MAX_CUTS + 2], i: usize| v.get(i).copied().unwrap_or(T::ZERO);
+            ParamRect { t0: at(&self.t, i), t1: at(&self.t, i + 1), s0: at(&self.s, j), s1: at(&self.s, j + 1) }
+        })
+    }
+}
+
+/// `Some` cuts of both patches where the pair methods would otherwise meet a contact that no
+/// transform of theirs matches, integrating it as separate with the 1/L² singularity on or
+/// inside both patches, which the boundary path can only refine towards, at a cost without
+/// bound (a cylinder wall in 3 cells closed by disks in 4 sectors: minutes per pair):
+/// - patches on one map (the same points and normals of one direction at the corners and
+///   centre of the common parameter rectangle) whose rectangles overlap without being the
+///   same: each is cut where the other's bounds fall inside it, so that the common rectangle
+///   is one cell of both, an identical pair;
+/// - a corner of one patch on an edge of the other, not at its ends: the edge's patch is cut
+///   there, so that the contact becomes a shared edge or vertex with matching corners.
+///
+/// Cutting is exact whatever the geometry (the integral is additive): a cut that was not
+/// needed costs only work. `None` where nothing is cut.
+pub(crate) fn contact_cuts<T, SA, SB>(a: &Patch<'_, T, SA>, b: &Patch<'_, T, SB>) -> Option<(Cuts<T>, Cuts<T>)>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+{
+    let (ra, rb) = (a.rect(), b.rect());
+    let (mut ca, mut cb) = (Cuts::new(ra), Cuts::new(rb));
+    if same_map_overlap(a, b) {
+        for (c, r) in [(&mut ca, rb), (&mut cb, ra)] {
+            c.cut_t(r.t0);
+            c.cut_t(r.t1);
+            c.cut_s(r.s0);
+            c.cut_s(r.s1);
+        }
+    } else {
+        let (ba, bb) = (a.enclosing_ball(), b.enclosing_ball());
+        let reach = (ba.radius + bb.radius) * T::from_f64(1.25);
+        if !((ba.center - bb.center).norm() <= reach) {
+            return None;
+        }
+        corners_on_edges(a, &corner_points(b), &mut ca);
+        corners_on_edges(b, &corner_points(a), &mut cb);
+    }
+    (ca.count() > 1 || cb.count() > 1).then_some((ca, cb))
+}
+
+/// Whether `a` and `b` lie on one map with parameter rectangles that overlap in more than an
+/// edge and are not the same (see [`contact_cuts`]).
+fn same_map_overlap<T, SA, SB>(a: &Patch<'_, T, SA>, b: &Patch<'_, T, SB>) -> bool
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+{
+    let (ra, rb) = (a.rect(), b.rect());
+    if ra == rb {
+        return false;
+    }
+    let common = ParamRect { t0: ra.t0.max(rb.t0), t1: ra.t1.min(rb.t1), s0: ra.s0.max(rb.s0), s1: ra.s1.min(rb.s1) };
+    if !(common.t0 < common.t1 && common.s0 < common.s1) {
+        return false;
+    }
+    let (ga, gb) = (a.surface(), b.surface());
+    let size = (ga.point(common.t0, common.s0) - ga.point(common.t1, common.s1))
+        .norm()
+        .max((ga.point(common.t1, common.s0) - ga.point(common.t0, common.s1)).norm());
+    if !(size > T::ZERO && size.is_finite()) {
+        return false;
+    }
+    let tolerance = size * adjacency_tolerance::<T>();
+    let (tm, sm) = ((common.t0 + common.t1) * T::HALF, (common.s0 + common.s1) * T::HALF);
+    let at = [(common.t0, common.s0), (common.t1, common.s0), (common.t0, common.s1), (common.t1, common.s1), (tm, sm)];
+    at.iter().all(|&(t, s)| (ga.point(t, s) - gb.point(t, s)).norm() <= tolerance)
+        && ga.normal(tm, sm).dot(gb.normal(tm, sm)) > T::ZERO
+}
+
+/// Samples along an edge when looking for corners on it.
+const EDGE_SAMPLES: usize = 17;
+
+/// Cuts `p` where one of `corners` lies on one of its edges, strictly between the edge's ends
+/// (within `adjacency_tolerance` of the edge's length, as `classify` matches corners): the
+/// nearest of `EDGE_SAMPLES` points along the edge, then a golden-section search between its
+/// neighbours for the nearest point. A corner farther from every sample than half the largest
+/// sample spacing (plus the tolerance) cannot lie on the edge and costs no search.
+fn corners_on_edges<T, S>(p: &Patch<'_, T, S>, corners: &[Vec3<T>; 4], cuts: &mut Cuts<T>)
+where
+    T: Real,
+    S: Surface<T> + ?Sized,
+{
+    let r = p.rect();
+    let g = p.surface();
+    // (along t?, the fixed other parameter)
+    for (along_t, fixed) in [(true, r.s0), (true, r.s1), (false, r.t0), (false, r.t1)] {
+        let (lo, hi) = if along_t { (r.t0, r.t1) } else { (r.s0, r.s1) };
+        let at = |u: T| if along_t { g.point(u, fixed) } else { g.point(fixed, u) };
+        let param = |k: usize| lo + (hi - lo) * (T::from_usize(k) / T::from_usize(EDGE_SAMPLES - 1));
+        let mut samples = [Vec3::ZERO; EDGE_SAMPLES];
+        for (k, x) in samples.iter_mut().enumerate() {
+            *x = at(param(k));
+        }
+        let (mut length, mut spacing) = (T::ZERO, T::ZERO);
+        for w in samples.windows(2) {
+            if let [x, y] = w {
+                let d = (*y - *x).norm();
+                length += d;
+                spacing = spacing.max(d);
+            }
+        }
+        if !(length > T::ZERO && length.is_finite()) {
+            continue;
+        }
+        let tolerance = length * adjacency_tolerance::<T>();
+        for &c in corners {
+            let Some((k, d)) = samples
+                .iter()
+                .map(|x| (*x - c).norm())
+                .enumerate()
+                .min_by(|x, y| x.1.partial_cmp(&y.1).unwrap_or(core::cmp::Ordering::Equal))
+            else {
+                continue;
+            };
+            if !(d <= spacing * T::HALF + tolerance) {
+                continue;
+            }
+            let (mut x0, mut x1) = (param(k.saturating_sub(1)), param((k + 1).min(EDGE_SAMPLES - 1)));
+            let distance = |u: T| (at(u) - c).norm();
+            // Golden-section search: the bracket shrinks by 0.618 a step; 60 steps take 1/8 of
+            // the edge below 1e-13 of it.
+            let phi = T::from_f64(0.618_033_988_749_894_9);
+            let (mut u1, mut u2) = (x1 - (x1 - x0) * phi, x0 + (x1 - x0) * phi);
+            let (mut f1, mut f2) = (distance(u1), distance(u2));
+            for _ in 0..60 {
+                if f1 <= f2 {
+                    x1 = u2;
+                    (u2, f2) = (u1, f1);
+                    u1 = x1 - (x1 - x0) * phi;
+                    f1 = distance(u1);
+                } else {
+                    x0 = u1;
+                    (u1, f1) = (u2, f2);
+                    u2 = x0 + (x1 - x0) * phi;
+                    f2 = distance(u2);
+                }
+            }
+            let (u, f) = if f1 <= f2 { (u1, f1) } else { (u2, f2) };
+            if f <= tolerance {
+                if along_t {
+                    cuts.cut_t(u);
+                } else {
+                    cuts.cut_s(u);
+                }
+            }
+        }
+    }
 }
 
 /// Into how many pieces (along t, along s) a patch is cut before integration: a direction in

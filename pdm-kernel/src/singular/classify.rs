@@ -27,7 +27,7 @@ pub enum Adjacency {
     Identical,
 }
 
-pub(super) fn corner_points<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>) -> [Vec3<T>; 4] {
+pub(crate) fn corner_points<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>) -> [Vec3<T>; 4] {
     let r = p.rect();
     let s = p.surface();
     [s.point(r.t0, r.s0), s.point(r.t1, r.s0), s.point(r.t0, r.s1), s.point(r.t1, r.s1)]
@@ -40,7 +40,7 @@ pub(super) fn centre_of<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>) ->
 }
 
 /// Relative tolerance for "the same point" in adjacency detection.
-pub(super) fn adjacency_tolerance<T: Real>() -> T {
+pub(crate) fn adjacency_tolerance<T: Real>() -> T {
     T::GEOMETRY_TOLERANCE.sqrt() * T::from_f64(0.01)
 }
 

@@ -632,3 +632,95 @@ fn flat_patches_behind_each_other_are_zero_without_work() {
         pair_exchange::<f64, _, _, _, 256>(&pf, &Patch::whole(&across).unwrap(), settings(12), &()).unwrap().value;
     assert!(value > 0.0, "straddling: {value}");
 }
+
+/// A_a·F_{a→b} summed over the cells of two grids, and the evaluations, by both modes: the
+/// fixed orders (`settings(12)`) and the tolerance mode (1e-9, depth 4).
+fn grid_sums<SA: Surface<f64>, SB: Surface<f64>>(
+    a: &Patch<'_, f64, SA>,
+    (m, n): (usize, usize),
+    b: &Patch<'_, f64, SB>,
+    (p, q): (usize, usize),
+) -> [(f64, f64, u64); 2] {
+    let mut out = [(0.0, 0.0, 0u64); 2];
+    let adaptive = Adaptive { tolerance: 1e-9, max_order: 12, max_depth: 4, absolute: 0.0 };
+    for pa in a.grid(m, n).unwrap() {
+        for pb in b.grid(p, q).unwrap() {
+            let fixed = pair_exchange::<f64, _, _, _, 1024>(&pa, &pb, settings(12), &()).unwrap();
+            let tol = adaptive_exchange::<f64, _, _, _, 1024>(&pa, &pb, adaptive, &()).unwrap();
+            for (slot, e) in out.iter_mut().zip([fixed, tol]) {
+                slot.0 += e.value;
+                slot.1 += e.error.unwrap_or(0.0);
+                slot.2 += e.evaluations;
+            }
+        }
+    }
+    out
+}
+
+/// Prints and checks both modes' sums against `reference`: within `limit` relative (absolute
+/// for a zero), the tolerance mode within its estimate, and each mode's work at most `factor`
+/// × that of the same surfaces on grids whose edges match (`matched`). Integrated as separate, with
+/// the contact inside, one such pair took 1e7–1e8 evaluations (tens of seconds) or did not
+/// finish; cut at the contact, about what the matched grid takes.
+fn check_contact_sums(
+    what: &str,
+    sums: [(f64, f64, u64); 2],
+    matched: [(f64, f64, u64); 2],
+    reference: f64,
+    factor: u64,
+) {
+    let limit = 1e-11;
+    let modes = ["fixed order 12", "tolerance 1e-9"];
+    for (((value, estimate, evaluations), (_, _, work)), mode) in sums.into_iter().zip(matched).zip(modes) {
+        let actual = (value - reference).abs();
+        println!(
+            "{what}, {mode}: {value:.15e} vs {reference:.15e}: {actual:.2e} (estimate {estimate:.2e}), \
+             {evaluations} evaluations (matched grids: {work})"
+        );
+        assert!(actual <= limit * reference.abs().max(1.0), "{what}, {mode}: {actual:.2e} off");
+        assert!(evaluations <= factor * work, "{what}, {mode}: {evaluations} evaluations, matched {work}");
+        if mode.starts_with("tolerance") {
+            let allowance = 8.0 * f64::EPSILON * reference.abs();
+            assert!(actual <= estimate + allowance, "{what}: {actual:.2e} above the estimate {estimate:.2e}");
+        }
+    }
+}
+
+/// T-junctions: a disk in 4 sectors closing a cylinder wall cut into 3 cells around (the
+/// wall's bottom edges span 120°, the sectors' rims 90°: corners of each lie inside the
+/// other's edges), and the top disk in 5 sectors against 3 cells. Reference: C-41 and the sum
+/// rule, A_disk·F(disk → wall) = π·(1 − C-41(1, 1, H)). Matched: 4 and 5 wall cells around.
+#[test]
+fn t_junctions_disk_sectors_against_wall_cells_of_other_angles() {
+    let h = 0.6;
+    let wall = Cylinder::<f64>::new(v([0.0, 0.0, 0.0]), v([0.0, 0.0, 1.0]), 1.0, h, Side::Inner).unwrap();
+    let bottom = Disk::<f64>::new(v([0.0, 0.0, 0.0]), v([0.0, 0.0, 1.0]), 1.0).unwrap();
+    let top = Disk::<f64>::new(v([0.0, 0.0, h]), v([0.0, 0.0, -1.0]), 1.0).unwrap();
+    let reference = PI * (1.0 - exact::coaxial_disks(1.0, 1.0, h));
+    let (w, b, t) = (Patch::whole(&wall).unwrap(), Patch::whole(&bottom).unwrap(), Patch::whole(&top).unwrap());
+    let matched = grid_sums(&b, (1, 4), &w, (4, 2));
+    check_contact_sums("bottom 1x4 -> wall 3x2", grid_sums(&b, (1, 4), &w, (3, 2)), matched, reference, 4);
+    let matched = grid_sums(&t, (2, 5), &w, (5, 1));
+    check_contact_sums("top 2x5 -> wall 3x1", grid_sums(&t, (2, 5), &w, (3, 1)), matched, reference, 4);
+}
+
+/// Patches that overlap: each cell of a sphere's inside against the whole sphere (as one
+/// patch, which the kernel cuts into pieces at its seam and poles that the cells overlap
+/// partly, and across the seam only along part of an edge). Every point of a sphere's inside
+/// sees all of it: A_cell·F(cell → sphere) = A_cell. The outside sees none of itself: 0.
+/// Matched: the cell against every cell of the same grid. The whole sphere's pieces (2 × 4)
+/// overlaid on a 3 × 3 grid leave more, smaller contact pairs: up to 16 × the matched work
+/// (integrated as separate, the partial overlaps took 70–150 ×).
+#[test]
+fn cells_of_a_sphere_against_the_whole_sphere() {
+    for side in [Side::Inner, Side::Outer] {
+        let sphere = Sphere::<f64>::new(v([0.2, -0.1, 0.3]), 1.3, side).unwrap();
+        let whole = Patch::whole(&sphere).unwrap();
+        for cell in whole.grid(3, 3).unwrap() {
+            let reference = if side == Side::Inner { cell.area(24).unwrap() } else { 0.0 };
+            let matched = grid_sums(&cell, (1, 1), &whole, (3, 3));
+            let what = format!("{side:?} cell {:?} -> whole sphere", cell.rect());
+            check_contact_sums(&what, grid_sums(&cell, (1, 1), &whole, (1, 1)), matched, reference, 16);
+        }
+    }
+}
