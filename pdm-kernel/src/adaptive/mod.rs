@@ -341,6 +341,9 @@ where
         return Err(PdmError::CapacityExceeded { needed, capacity: CAP });
     }
     crate::pair::backend_resolves(a, b)?;
+    if crate::pair::on_one_convex_ball(a, b) {
+        return Ok(Estimate { value: T::ZERO, error: Some(T::ZERO), converged: true, evaluations: 0 });
+    }
     // Every leaf's estimate carries the rounding allowance ROUNDING·ε·|value|, so a leaf can
     // meet only a tolerance above it: below, the refinement would split every pair down to
     // `max_depth` without ever getting closer. It works to the precision floor instead, and

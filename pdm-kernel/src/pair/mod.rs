@@ -1,8 +1,12 @@
 //! One entry point for any pair of patches: picks the integration method the pair needs.
 //!
+//! - Two patches of one convex ball (cells of an outer sphere: `on_one_convex_ball`) cannot
+//!   see each other: zero, without work.
 //! - A patch whose image closes on itself (a whole disk, cylinder, cone or sphere as one
 //!   patch) is first cut at its seam into pieces (`pieces`); every pair of pieces is then
-//!   dispatched as below and the results are summed.
+//!   dispatched as below and the results are summed. A pair of pieces that overlap on one
+//!   map, or where a corner of one lies inside an edge of the other (grids that do not meet
+//!   edge to edge), is cut there first, into identical, touching and separate pairs.
 //! - Two flat patches that see each other wholly, with no occluder able to cut between them,
 //!   use the contour form (`contour/`), separate or touching: parallelograms with the inner
 //!   line integral in closed form, flat patches with curved edges (disk and annulus sectors,
@@ -219,6 +223,9 @@ where
     O: Occluder<T> + ?Sized,
 {
     backend_resolves(a, b)?;
+    if on_one_convex_ball(a, b) {
+        return Ok(Estimate::fixed(T::ZERO, 0));
+    }
     let (mut value, mut count, mut rounding) = (T::ZERO, 0u64, T::ZERO);
     for_each_piece_pair(a, b, |pa, pb| {
         let (v, c, r) = split_occluded_contacts::<T, SA, SB, O, CAP>(pa, pb, settings, occluders, 0)?;
@@ -241,6 +248,28 @@ where
     let band = value.abs() * T::from_f64(QUADRATURE_BAND);
     let value = crate::bounds::exchange_within(value, band, a.bounds_area(order)?, b.bounds_area(order)?)?;
     Ok(Estimate::fixed(value, count))
+}
+
+/// Whether both patches lie on the sphere bounding one ball with their normals pointing out of
+/// it ([`Surface::convex_ball`]: cells of one outer sphere, a cell and the whole sphere). A
+/// segment from such a patch that passes its facing test leaves the ball at once, so it never
+/// reaches the other patch: the exchange is exactly zero, and the pair takes no work (its
+/// pieces would otherwise go through the touching and identical transforms to sum zeros).
+/// The balls must agree to rounding: 16 ε of their size and position.
+pub(crate) fn on_one_convex_ball<T, SA, SB>(a: &Patch<'_, T, SA>, b: &Patch<'_, T, SB>) -> bool
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+{
+    #[cfg(feature = "closed-form")]
+    if let (Some(x), Some(y)) = (a.surface().convex_ball(), b.surface().convex_ball()) {
+        let scale = x.radius + x.center.norm();
+        let tight = T::from_f64(16.0) * T::EPSILON * scale;
+        return (x.center - y.center).norm() <= tight && (x.radius - y.radius).abs() <= tight;
+    }
+    let _ = (a, b);
+    false
 }
 
 /// Most successive 2 × 2 × 2 × 2 splits of a touching pair that an occluder may cut, before
