@@ -166,7 +166,10 @@ fn trig_size<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>) -> T {
 /// - across occluders other than spheres, or with a curved patch (a shadow edge meeting the
 ///   inner patch's corners and edges, sampled by the outer rule): about 1e-7 to 1e-5 relative
 ///   (a tube between a small square and a large one: 2.1e-5 at 16, its shadow's boundaries
-///   bisected rather than solved). Two parallelograms across one sphere have those curves placed
+///   bisected rather than solved); a curved outer patch across a sphere, which gets no outer
+///   events, converges slowly and not monotonically (a parallelogram against a cell of a
+///   sphere's inside around a concentric sphere: 2e-3 / 2e-4 / 3e-4 / 8e-5 at orders 8 / 12 /
+///   20 / 28). Two parallelograms across one sphere have those curves placed
 ///   into the outer rule and converge exponentially (whole cube faces around a sphere: 1.3e-8
 ///   at order 8, 1.6e-11 at 12); an occluder that cuts through the outer patch itself makes the
 ///   outer integrand jump along the cut, and the outer rule converges only like 1/order (a
