@@ -32,6 +32,13 @@
 //! tangency curve of each edge through that corner (where the circle touches the edge at its
 //! end), and ungraded there the outer rule converged only like n⁻⁷ on a cell holding that
 //! point.
+//!
+//! The roles reversed: a parallelogram inside a sphere's inside, across a smaller sphere with
+//! that sphere's centre, the sphere's cell outside ([`shell_flat_events`]). The boundaries on
+//! the parallelogram are then conics, but the curves on the outer sphere where they change
+//! their structure are again circles: a corner q is cut off at the angle acos(ρ/|q − c|) +
+//! acos(ρ/R) from p̂, the outline touches an edge where p lies on a plane through the edge
+//! tangent to the occluder, and p crosses the parallelogram's plane.
 
 use super::*;
 
@@ -196,6 +203,116 @@ where
         }
     }
     Some(events)
+}
+
+/// The outer events of a cell of a sphere (the outer patch, `outer`) against a parallelogram
+/// inside it (corners `corners`, unit normal `normal` to the side it radiates to), across one
+/// sphere occluder with the outer sphere's centre c and radius ρ, clear of the parallelogram:
+/// every boundary of what p sees of the parallelogram changes its structure on a plane
+/// section of the outer sphere (radius R; p = c + R·p̂):
+/// - a corner q is cut off where the segment p–q touches the occluder: the angle at c between
+///   p and q is acos(ρ/|q − c|) + acos(ρ/R) (as [`Concentric::plane`] with the roles swapped);
+/// - the shadow's outline touches an edge's line where p lies on one of the two planes through
+///   that line tangent to the occluder: with d the line's distance from c, v the unit vector
+///   from c to its foot and e its direction, the planes' normals are (ρ/d)·v ± √(1 − ρ²/d²)·
+///   e × v, and p̂·n = ρ/R on them;
+/// - p crosses the parallelogram's plane (its facing test changes sign for the whole of it).
+///
+/// p's own facing test passes for every point inside its sphere (the chord from p leaves
+/// along the inward normal), so it puts no boundary on the parallelogram. `None` where the
+/// parallelogram reaches outside the outer sphere, the occluder is not concentric with it and
+/// smaller, or the parallelogram comes within the occluder. (Where its plane cuts the
+/// occluder, the part of the shadow's outline on the parallelogram is still the tangent
+/// cone's: the outline leaves it only on the occluder itself.)
+pub(super) fn shell_flat_events<T, SA>(
+    outer: &SA,
+    corners: [Vec3<T>; 4],
+    normal: Vec3<T>,
+    occluder: &Ball<T>,
+) -> Option<ConcentricEvents<T>>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+{
+    let shell = outer.on_sphere()?;
+    let (c, big, rho) = (shell.center, shell.radius, occluder.radius);
+    let margin = T::GEOMETRY_TOLERANCE * big;
+    if !(same_centre(occluder, &shell) && rho > T::ZERO && rho + margin < big) {
+        return None;
+    }
+    let [q0, ..] = corners;
+    if !(distance_to_polygon(c, &corners, normal) > rho + margin)
+        || !corners.iter().all(|q| (*q - c).norm() + margin < big)
+    {
+        return None;
+    }
+    let mut events = ConcentricEvents::empty();
+    let mut section = |e: Vec3<T>, k: T| -> Option<()> {
+        let [curve, _] = outer.facing_across_s(c + e.scale(big * k), e)?;
+        events.push(curve, true)
+    };
+    let y = rho / big;
+    let sin_y = (T::ONE - y * y).max(T::ZERO).sqrt();
+    for q in corners {
+        let v = q - c;
+        let d = v.norm();
+        let x = rho / d;
+        let cos_psi = x * y - (T::ONE - x * x).max(T::ZERO).sqrt() * sin_y;
+        section(v.scale(T::ONE / d), cos_psi)?;
+    }
+    for (i, q) in corners.iter().enumerate() {
+        let next = *corners.get((i + 1) % 4)?;
+        let edge = next - *q;
+        let length = edge.norm();
+        if !(length > margin) {
+            continue;
+        }
+        let e = edge.scale(T::ONE / length);
+        let foot = *q + e.scale((c - *q).dot(e));
+        let to_foot = foot - c;
+        let d = to_foot.norm();
+        if !(d > rho) {
+            // The edge's line passes through the occluder: every plane through it cuts the
+            // occluder, so the outline crosses the line and never touches it.
+            continue;
+        }
+        let v = to_foot.scale(T::ONE / d);
+        let w = e.cross(v);
+        let (along, across) = (rho / d, (T::ONE - (rho / d) * (rho / d)).max(T::ZERO).sqrt());
+        for sign in [T::ONE, -T::ONE] {
+            section(v.scale(along) + w.scale(sign * across), y)?;
+        }
+    }
+    let k = normal.dot(q0 - c) / big;
+    if k.abs() < T::ONE {
+        section(normal, k)?;
+    }
+    Some(events)
+}
+
+/// The distance from `x` to a convex planar polygon (corners in order around it, unit normal
+/// `normal`): to its plane where x's foot lies inside it, else to its nearest edge.
+fn distance_to_polygon<T: Real>(x: Vec3<T>, corners: &[Vec3<T>; 4], normal: Vec3<T>) -> T {
+    let [q0, ..] = *corners;
+    let height = normal.dot(x - q0);
+    let foot = x - normal.scale(height);
+    let (mut inside, mut outside) = (true, true);
+    let mut nearest = T::MAX;
+    for (i, q) in corners.iter().enumerate() {
+        let Some(next) = corners.get((i + 1) % 4) else { continue };
+        let edge = *next - *q;
+        let side = edge.cross(foot - *q).dot(normal);
+        inside &= side >= T::ZERO;
+        outside &= side <= T::ZERO;
+        let length2 = edge.dot(edge);
+        let u = if length2 > T::ZERO { ((x - *q).dot(edge) / length2).max(T::ZERO).min(T::ONE) } else { T::ZERO };
+        nearest = nearest.min((x - (*q + edge.scale(u))).norm());
+    }
+    if inside || outside {
+        height.abs()
+    } else {
+        nearest
+    }
 }
 
 #[cfg(test)]

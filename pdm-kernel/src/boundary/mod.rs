@@ -318,10 +318,8 @@ where
     O: Occluder<T> + ?Sized,
 {
     let surface = a.surface();
-    if inner.concentric.is_some() || !inner.use_occluders {
-        if let Some(total) = concentric_sum(a, cells, inner, inner_samples, inner_bounds)? {
-            return Ok(Some(total));
-        }
+    if let Some(total) = concentric_sum(a, cells, inner, inner_samples, inner_bounds)? {
+        return Ok(Some(total));
     }
     let events = match surface.affine_map() {
         Some(outer_map) => pair_events(
@@ -351,10 +349,11 @@ where
 }
 
 /// The outer integral over the cells of a sphere's cell a against a cell of a sphere with the
-/// same centre, across a sphere occluder concentric with both or none, with the events placed
-/// into the outer rule (`concentric.rs`); `None` where they are not available
-/// ([`concentric_events`]). In a frame of its own: the events take more room than the other
-/// kinds'.
+/// same centre, across a sphere occluder concentric with both or none ([`concentric_events`]),
+/// or against a parallelogram inside a's sphere across a sphere with its centre
+/// ([`shell_flat_of`]), with the events placed into the outer rule (`concentric.rs`); `None`
+/// where they are not available. In a frame of its own: the events take more room than the
+/// other kinds'.
 #[cfg(feature = "closed-form")]
 #[inline(never)]
 fn concentric_sum<T, SA, SB, O, const CB: usize>(
@@ -371,15 +370,51 @@ where
     O: Occluder<T> + ?Sized,
 {
     let surface = a.surface();
-    let Some(events) = concentric_events(surface, inner.surface, inner.r, inner.concentric.as_ref()) else {
-        return Ok(None);
+    let events = if inner.concentric.is_some() || !inner.use_occluders {
+        concentric_events(surface, inner.surface, inner.r, inner.concentric.as_ref())
+    } else if inner.parallelogram.is_some() && surface.on_sphere().is_some() {
+        let (from, part) = (a.enclosing_ball(), Patch::new(inner.surface, inner.r)?);
+        shell_flat_of(surface, &part, inner.parallelogram, true, inner.occluders, (&from, inner_bounds))
+    } else {
+        None
     };
+    let Some(events) = events else { return Ok(None) };
     let mut f = |t: T, s: T| outer_integrand(surface, t, s, inner, inner_samples, inner_bounds);
     let mut total = T::ZERO;
     for cell in cells {
         total += events.integrate(*cell, &inner.rule, &mut f)?;
     }
     Ok(Some(total))
+}
+
+/// The outer events of a cell of a sphere against a parallelogram inside it across one sphere
+/// with the outer sphere's centre (`concentric::shell_flat_events`), for the patch `inner`
+/// (its surface's affine map `map`) seen from the ball `from`; `None` where they do not apply.
+#[cfg(feature = "closed-form")]
+fn shell_flat_of<T, SA, SB, O>(
+    outer: &SA,
+    inner: &Patch<'_, T, SB>,
+    map: Option<(Vec3<T>, Vec3<T>, Vec3<T>)>,
+    use_occluders: bool,
+    occluders: &O,
+    (from, bounds): (&Ball<T>, &Ball<T>),
+) -> Option<ConcentricEvents<T>>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
+    let map = map.filter(|_| use_occluders)?;
+    outer.on_sphere()?;
+    let occluder = occluders.shadow_sphere(from, bounds)??;
+    let r = inner.rect();
+    let n = inner.surface().normal((r.t0 + r.t1) * T::HALF, (r.s0 + r.s1) * T::HALF);
+    let length = n.norm();
+    if !(length > T::ZERO) {
+        return None;
+    }
+    shell_flat_events(outer, map_corners(map, r), n.scale(T::ONE / length), &occluder)
 }
 
 /// The corners of the parallelogram with affine map (o, e_t, e_s) over `r`, in order around it.
@@ -554,13 +589,19 @@ where
             let inner_map = affine.filter(|_| use_occluders)?;
             polygon_events_state(outer_map, outer.rect(), inner_map, r, occluders, &bounds)
         }
-        None => curved_outer_events(outer.surface(), affine, r, use_occluders).map(|_| true).or_else(|| {
-            let concentric = match use_occluders {
-                true => Some(Concentric::of(surface, &bounds, &outer.enclosing_ball(), occluders)?),
-                false => None,
-            };
-            concentric_events(outer.surface(), surface, r, concentric.as_ref()).map(|_| true)
-        }),
+        None => curved_outer_events(outer.surface(), affine, r, use_occluders)
+            .map(|_| true)
+            .or_else(|| {
+                let concentric = match use_occluders {
+                    true => Some(Concentric::of(surface, &bounds, &outer.enclosing_ball(), occluders)?),
+                    false => None,
+                };
+                concentric_events(outer.surface(), surface, r, concentric.as_ref()).map(|_| true)
+            })
+            .or_else(|| {
+                let from = outer.enclosing_ball();
+                shell_flat_of(outer.surface(), inner, affine, use_occluders, occluders, (&from, &bounds)).map(|_| true)
+            }),
     }
 }
 

@@ -32,7 +32,7 @@
 //!   refined towards each outer point (`boundary/`; when an occluder may cut, the outer
 //!   events are placed into the outer rule where `boundary::outer_events_apply` gives them —
 //!   two parallelograms across one sphere or flat convex occluders, cells of spheres with the
-//!   occluding sphere's centre — and the outer patch is split `OCCLUDED_OUTER_SPLIT`²
+//!   occluding sphere's centre, against each other or around a parallelogram — and the outer patch is split `OCCLUDED_OUTER_SPLIT`²
 //!   otherwise); smooth, distant, unoccludable pairs
 //!   keep the plain sum. Without occluders the outer patch is, for a very near pair with one
 //!   flat patch, the curved one; otherwise the one with fewer points that see none of the
@@ -167,9 +167,10 @@ fn trig_size<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>) -> T {
 ///   inner patch's corners and edges, sampled by the outer rule): about 1e-7 to 1e-5 relative
 ///   (a tube between a small square and a large one: 2.1e-5 at 16, its shadow's boundaries
 ///   bisected rather than solved); a curved outer patch across a sphere, which gets no outer
-///   events, converges slowly and not monotonically (a parallelogram against a cell of a
-///   sphere's inside around a concentric sphere: 2e-3 / 2e-4 / 3e-4 / 8e-5 at orders 8 / 12 /
-///   20 / 28). Two parallelograms across one sphere have those curves placed
+///   events, converges slowly and not monotonically (cells of two spheres with a third
+///   between: 9e-4 / 1e-3 / 2e-4 / 1e-4 at orders 8 / 12 / 16 / 20) — except a sphere's cell
+///   around a parallelogram inside it across a sphere with its centre, whose events are
+///   placed (`boundary/concentric.rs`). Two parallelograms across one sphere have those curves placed
 ///   into the outer rule and converge exponentially (whole cube faces around a sphere: 1.3e-8
 ///   at order 8, 1.6e-11 at 12); an occluder that cuts through the outer patch itself makes the
 ///   outer integrand jump along the cut, and the outer rule converges only like 1/order (a
@@ -429,7 +430,7 @@ where
 /// an occluder may cut, shadow edges crossing the inner patch make the outer integrand kink
 /// where they touch its edges: where `boundary::outer_events_apply` gives those curves (two
 /// parallelograms across one sphere or flat convex occluders, cells of spheres with the
-/// occluding sphere's centre) they are placed into the outer rule, elsewhere the outer patch
+/// occluding sphere's centre, against each other or around a parallelogram) they are placed into the outer rule, elsewhere the outer patch
 /// is split `OCCLUDED_OUTER_SPLIT`².
 fn separate<T, SA, SB, O, const CAP: usize>(
     pair: &mut PairContext<'_, '_, T, SA, SB, O, CAP>,

@@ -729,3 +729,83 @@ fn cells_of_a_sphere_against_the_whole_sphere() {
         }
     }
 }
+
+/// A parallelogram inside a sphere's inside, across a smaller sphere with the same centre: the
+/// sphere cell is the outer patch, and its outer events are circles of its sphere (the
+/// occluder's tangent cones through the parallelogram's corners and the planes through its
+/// edges tangent to the occluder, `boundary/concentric.rs`). Red-team cases of the thirty-fifth
+/// session (FUZZING.md), as (a's origin, edges, rect; b's radius, frame (u, w, axis), rect;
+/// occluder radius; reference). Each reference is the helper's independent computation (its own
+/// geometry, segment–sphere test and adaptive Gauss–Kronrod, no pdm code) at tolerance 1e-9
+/// with 9 initial pieces per level, uncertainty 1e-8 relative (its floor). Before the events,
+/// the fixed orders 8 / 16 / 20 were up to 2e-3 / 4e-4 / 3.4e-4 off, not monotone.
+#[test]
+fn parallelograms_inside_a_shell_around_a_concentric_sphere() {
+    type Case = ([[f64; 3]; 3], [f64; 4], f64, [[f64; 3]; 3], [f64; 4], f64, f64);
+    let cases: [(&str, Case); 2] = [
+        (
+            "1009",
+            (
+                [
+                    [0.6647921387363426, 0.35513971611874817, 0.8659044802034667],
+                    [-0.3480615837009827, 0.18002450062927539, -0.11002180044502936],
+                    [-0.02801803313928252, 0.11200959943162943, 0.2719140485703725],
+                ],
+                [0.5478021499860282, 0.9904346907422505, 0.0929405502473882, 0.8048356190332533],
+                1.5859558347341183,
+                [
+                    [0.9466435043807694, 0.09451193802706966, 0.30811291628892107],
+                    [0.17234508827399397, 0.6593934692383877, -0.7317768944655144],
+                    [-0.272329297288275, 0.7458335915578826, 0.6079218761833987],
+                ],
+                [1.12066044404378, 1.4454802496775114, 2.067195423598212, 4.2270023051631895],
+                0.5774062872214444,
+                7.961658289601073e-5,
+            ),
+        ),
+        (
+            "1010",
+            (
+                [
+                    [1.1341770162822575, 0.7689552444841707, -0.3117246479034596],
+                    [0.05681239183981273, -0.12132221875665537, 0.031485224876152455],
+                    [0.0030436948573270323, -0.04170917807490758, -0.14730268448102668],
+                ],
+                [0.0, 1.0, 0.0, 1.0],
+                1.661997962023971,
+                [
+                    [0.00829456310224151, 0.8441200297919634, 0.5360900815413],
+                    [0.5990901857673819, -0.4334388206870291, 0.6732174522683152],
+                    [0.8006385885904743, 0.3155822618992586, -0.509299211107185],
+                ],
+                [0.8631332917053611, 1.9138676576153748, 1.0783809493764902, 2.5818486729217396],
+                1.0962709742390524,
+                1.124676808549949e-5,
+            ),
+        ),
+    ];
+    let rect = |r: [f64; 4]| ParamRect::new(r[0], r[1], r[2], r[3]).unwrap();
+    for (name, (a, ra, radius, frame, rb, rho, reference)) in cases {
+        let flat = square::<f64>(a[0], a[1], a[2]);
+        let frame = Frame { u: v(frame[0]), w: v(frame[1]), axis: v(frame[2]) };
+        let shell = Sphere::<f64>::with_frame(v([0.0; 3]), radius, frame, Side::Inner).unwrap();
+        let occluder = [Sphere::<f64>::outer(v([0.0; 3]), rho).unwrap()];
+        let (pa, pb) = (Patch::new(&flat, rect(ra)).unwrap(), Patch::new(&shell, rect(rb)).unwrap());
+        let at = |order: usize| exchange(&pa, &pb, settings(order), &occluder).unwrap();
+        let (e8, e16) = (at(8), at(16));
+        let adaptive = Adaptive { tolerance: 1e-9, max_order: 16, max_depth: 4, absolute: 0.0 };
+        let tol = adaptive_exchange::<f64, _, _, _, 1024>(&pa, &pb, adaptive, &occluder).unwrap();
+        let estimate = tol.error.unwrap();
+        println!(
+            "case {name}: order 8 {e8:.15e}, 16 {e16:.15e} ({:.1e} apart); tolerance 1e-9 {:.15e} (estimate {estimate:.1e}, \
+             converged {}); reference {reference:.15e}: {:.1e} off",
+            (e8 / e16 - 1.0).abs(),
+            tol.value,
+            tol.converged,
+            (e16 / reference - 1.0).abs()
+        );
+        assert!((e8 / e16 - 1.0).abs() < 1e-11, "case {name}: orders 8 and 16 {e8} / {e16}");
+        assert!((e16 / reference - 1.0).abs() < 3e-8, "case {name}: {e16} vs the reference {reference}");
+        assert!(tol.converged && (tol.value - e16).abs() <= estimate + 1e-14 * e16, "case {name}: {tol:?}");
+    }
+}
