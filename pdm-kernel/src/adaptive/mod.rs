@@ -352,8 +352,8 @@ where
     let work = Adaptive { tolerance: settings.tolerance.max(floor), ..settings };
     // Closed patches are cut at their seams first, as in `pair_exchange`.
     let mut e = Tally::zero(0);
-    let pieces = work.share(crate::pair::piece_pairs(a, b));
-    crate::pair::for_each_piece_pair(a, b, |pa, pb| {
+    let pieces = work.share(crate::pair::piece_pairs(a, b, occluders));
+    crate::pair::for_each_piece_pair(a, b, occluders, |pa, pb| {
         e.add(recurse::<T, SA, SB, O, CAP>(pa, pb, pieces, occluders, 0)?);
         Ok(())
     })?;

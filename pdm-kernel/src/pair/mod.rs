@@ -231,7 +231,7 @@ where
         return Ok(Estimate::fixed(T::ZERO, 0));
     }
     let (mut value, mut count, mut rounding) = (T::ZERO, 0u64, T::ZERO);
-    for_each_piece_pair(a, b, |pa, pb| {
+    for_each_piece_pair(a, b, occluders, |pa, pb| {
         let (v, c, r) = split_occluded_contacts::<T, SA, SB, O, CAP>(pa, pb, settings, occluders, 0)?;
         value += v;
         count = count.saturating_add(c);

@@ -4,6 +4,7 @@
 use super::*;
 use crate::singular::{adjacency_tolerance, corner_points};
 use crate::surface::ParamRect;
+use crate::visibility::Occluder;
 
 /// Calls `f` on every pair of pieces of a and b (see [`pieces`]): the pair methods then see
 /// only patches whose four corners are distinct unless an edge collapses to a point. A piece
@@ -11,23 +12,28 @@ use crate::surface::ParamRect;
 /// ([`contact_cuts`]): two patches on one map whose parameter rectangles overlap, or a corner
 /// of one lying on an edge of the other (a T-junction: a disk's sector against a cylinder
 /// wall's cell whose edges span other angles, two cells across a closed surface's seam).
-pub(crate) fn for_each_piece_pair<'s, 'r, T, SA, SB>(
+pub(crate) fn for_each_piece_pair<'s, 'r, T, SA, SB, O>(
     a: &Patch<'s, T, SA>,
     b: &Patch<'r, T, SB>,
+    occluders: &O,
     mut f: impl FnMut(&Patch<'s, T, SA>, &Patch<'r, T, SB>) -> Result<(), PdmError>,
 ) -> Result<(), PdmError>
 where
     T: Real,
     SA: Surface<T> + ?Sized,
     SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
 {
     let ((ma, na), (mb, nb)) = (pieces(a), pieces(b));
+    if ma * na * mb * nb == 1 && contact_cuts(a, b, occluders).is_none() {
+        return f(a, b);
+    }
     let (ra, rb) = (a.rect(), b.rect());
     for i in 0..ma * na {
         let pa = Patch::new(a.surface(), ra.cell(i / na, i % na, ma, na))?;
         for j in 0..mb * nb {
             let pb = Patch::new(b.surface(), rb.cell(j / nb, j % nb, mb, nb))?;
-            match contact_cuts(&pa, &pb) {
+            match contact_cuts(&pa, &pb, occluders) {
                 None => f(&pa, &pb)?,
                 Some((ca, cb)) => {
                     for x in ca.rects() {
@@ -44,11 +50,12 @@ where
 }
 
 /// How many piece pairs [`for_each_piece_pair`] visits for `a` × `b`.
-pub(crate) fn piece_pairs<T, SA, SB>(a: &Patch<'_, T, SA>, b: &Patch<'_, T, SB>) -> usize
+pub(crate) fn piece_pairs<T, SA, SB, O>(a: &Patch<'_, T, SA>, b: &Patch<'_, T, SB>, occluders: &O) -> usize
 where
     T: Real,
     SA: Surface<T> + ?Sized,
     SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
 {
     let ((ma, na), (mb, nb)) = (pieces(a), pieces(b));
     let (ra, rb) = (a.rect(), b.rect());
@@ -61,7 +68,7 @@ where
             let Ok(pb) = Patch::new(b.surface(), rb.cell(j / nb, j % nb, mb, nb)) else {
                 return ma * na * mb * nb;
             };
-            count += contact_cuts(&pa, &pb).map_or(1, |(ca, cb)| ca.count() * cb.count());
+            count += contact_cuts(&pa, &pb, occluders).map_or(1, |(ca, cb)| ca.count() * cb.count());
         }
     }
     count
@@ -158,12 +165,19 @@ impl<T: Real> Cuts<T> {
 ///   there, so that the contact becomes a shared edge or vertex with matching corners.
 ///
 /// Cutting is exact whatever the geometry (the integral is additive): a cut that was not
-/// needed costs only work. `None` where nothing is cut.
-pub(crate) fn contact_cuts<T, SA, SB>(a: &Patch<'_, T, SA>, b: &Patch<'_, T, SB>) -> Option<(Cuts<T>, Cuts<T>)>
+/// needed costs only work. `None` where nothing is cut, and for two flat patches with
+/// straight edges that no occluder can cut between: the contour form integrates any contact
+/// between those exactly (`pair::flat`), and the test would only cost it time.
+pub(crate) fn contact_cuts<T, SA, SB, O>(
+    a: &Patch<'_, T, SA>,
+    b: &Patch<'_, T, SB>,
+    occluders: &O,
+) -> Option<(Cuts<T>, Cuts<T>)>
 where
     T: Real,
     SA: Surface<T> + ?Sized,
     SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
 {
     let (ra, rb) = (a.rect(), b.rect());
     let (mut ca, mut cb) = (Cuts::new(ra), Cuts::new(rb));
@@ -175,11 +189,20 @@ where
             c.cut_s(r.s1);
         }
     } else {
-        let (ba, bb) = (a.enclosing_ball(), b.enclosing_ball());
+        let (ba, bb) = (contact_ball(a), contact_ball(b));
         let reach = (ba.radius + bb.radius) * T::from_f64(1.25);
         if !((ba.center - bb.center).norm() <= reach) {
             return None;
         }
+        #[cfg(feature = "closed-form")]
+        if a.surface().straight_corners(ra).is_some()
+            && b.surface().straight_corners(rb).is_some()
+            && !occluders.may_block_between(&ba, &bb)
+        {
+            return None;
+        }
+        #[cfg(not(feature = "closed-form"))]
+        let _ = occluders;
         corners_on_edges(a, &corner_points(b), &mut ca);
         corners_on_edges(b, &corner_points(a), &mut cb);
     }
@@ -216,6 +239,64 @@ where
         && ga.normal(tm, sm).dot(gb.normal(tm, sm)) > T::ZERO
 }
 
+/// A ball holding the patch for the contact test of [`contact_cuts`]: a flat patch's with
+/// straight edges from its corners (exact for a convex polygon), else
+/// [`Patch::enclosing_ball`].
+fn contact_ball<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>) -> crate::samples::Ball<T> {
+    #[cfg(feature = "closed-form")]
+    if let Some(c) = p.surface().straight_corners(p.rect()) {
+        let center = c.iter().fold(Vec3::ZERO, |s, x| s + *x).scale(T::from_f64(0.25));
+        let radius = c.iter().fold(T::ZERO, |m, x| m.max((*x - center).norm()));
+        return crate::samples::Ball { center, radius };
+    }
+    p.enclosing_ball()
+}
+
+/// [`corners_on_edges`] for a flat patch with straight edges (`straight`, its corners in
+/// order): each corner's foot on each edge's segment in closed form, the cut where it lies
+/// inside the segment within the tolerance and the patch's own point at that parameter (the
+/// parameterisation along a straight edge need not be linear) is within it too.
+#[cfg(feature = "closed-form")]
+fn corners_on_straight_edges<T, S>(
+    p: &Patch<'_, T, S>,
+    straight: [Vec3<T>; 4],
+    corners: &[Vec3<T>; 4],
+    cuts: &mut Cuts<T>,
+) where
+    T: Real,
+    S: Surface<T> + ?Sized,
+{
+    let (r, g) = (p.rect(), p.surface());
+    let [c0, c1, c2, c3] = straight;
+    for (along_t, fixed, x0, x1) in
+        [(true, r.s0, c0, c1), (true, r.s1, c3, c2), (false, r.t0, c0, c3), (false, r.t1, c1, c2)]
+    {
+        let e = x1 - x0;
+        let l2 = e.dot(e);
+        if !(l2 > T::ZERO && l2.is_finite()) {
+            continue;
+        }
+        let tolerance = l2.sqrt() * adjacency_tolerance::<T>();
+        let (lo, hi) = if along_t { (r.t0, r.t1) } else { (r.s0, r.s1) };
+        for &q in corners {
+            let u = (q - x0).dot(e) / l2;
+            let inside = u > T::from_f64(MIN_CUT) && u < T::ONE - T::from_f64(MIN_CUT);
+            if !inside || !((q - x0 - e.scale(u)).norm() <= tolerance) {
+                continue;
+            }
+            let x = lo + (hi - lo) * u;
+            let at = if along_t { g.point(x, fixed) } else { g.point(fixed, x) };
+            if (at - q).norm() <= tolerance {
+                if along_t {
+                    cuts.cut_t(x);
+                } else {
+                    cuts.cut_s(x);
+                }
+            }
+        }
+    }
+}
+
 /// Samples along an edge when looking for corners on it.
 const EDGE_SAMPLES: usize = 17;
 
@@ -231,6 +312,11 @@ where
 {
     let r = p.rect();
     let g = p.surface();
+    #[cfg(feature = "closed-form")]
+    if let Some(straight) = g.straight_corners(r) {
+        corners_on_straight_edges(p, straight, corners, cuts);
+        return;
+    }
     // (along t?, the fixed other parameter)
     for (along_t, fixed) in [(true, r.s0), (true, r.s1), (false, r.t0), (false, r.t1)] {
         let (lo, hi) = if along_t { (r.t0, r.t1) } else { (r.s0, r.s1) };
@@ -261,7 +347,9 @@ where
             else {
                 continue;
             };
-            if !(d <= spacing * T::HALF + tolerance) {
+            // Farther than half a spacing from every sample, or at one of the edge's ends.
+            let at_end = k == 0 || k + 1 == EDGE_SAMPLES;
+            if !(d <= spacing * T::HALF + tolerance) || (at_end && d <= tolerance) {
                 continue;
             }
             let (mut x0, mut x1) = (param(k.saturating_sub(1)), param((k + 1).min(EDGE_SAMPLES - 1)));
