@@ -206,7 +206,7 @@ where
 }
 
 /// The outer events of a cell of a sphere (the outer patch, `outer`) against a parallelogram
-/// inside it (corners `corners`, unit normal `normal` to the side it radiates to), across one
+/// inside it (its affine map over a rectangle, unit normal `normal` to the side it radiates to), across one
 /// sphere occluder with the outer sphere's centre c and radius ρ, clear of the parallelogram:
 /// every boundary of what p sees of the parallelogram changes its structure on a plane
 /// section of the outer sphere (radius R; p = c + R·p̂):
@@ -226,7 +226,7 @@ where
 /// cone's: the outline leaves it only on the occluder itself.)
 pub(super) fn shell_flat_events<T, SA>(
     outer: &SA,
-    corners: [Vec3<T>; 4],
+    (map, r): MappedRect<T>,
     normal: Vec3<T>,
     occluder: &Ball<T>,
 ) -> Option<ConcentricEvents<T>>
@@ -240,10 +240,10 @@ where
     if !(same_centre(occluder, &shell) && rho > T::ZERO && rho + margin < big) {
         return None;
     }
+    let corners = map_corners(map, r);
     let [q0, ..] = corners;
-    if !(distance_to_polygon(c, &corners, normal) > rho + margin)
-        || !corners.iter().all(|q| (*q - c).norm() + margin < big)
-    {
+    let clear = distance_to_parallelogram(c, map, r) > rho + margin;
+    if !clear || !corners.iter().all(|q| (*q - c).norm() + margin < big) {
         return None;
     }
     let mut events = ConcentricEvents::empty();
@@ -288,31 +288,6 @@ where
         section(normal, k)?;
     }
     Some(events)
-}
-
-/// The distance from `x` to a convex planar polygon (corners in order around it, unit normal
-/// `normal`): to its plane where x's foot lies inside it, else to its nearest edge.
-fn distance_to_polygon<T: Real>(x: Vec3<T>, corners: &[Vec3<T>; 4], normal: Vec3<T>) -> T {
-    let [q0, ..] = *corners;
-    let height = normal.dot(x - q0);
-    let foot = x - normal.scale(height);
-    let (mut inside, mut outside) = (true, true);
-    let mut nearest = T::MAX;
-    for (i, q) in corners.iter().enumerate() {
-        let Some(next) = corners.get((i + 1) % 4) else { continue };
-        let edge = *next - *q;
-        let side = edge.cross(foot - *q).dot(normal);
-        inside &= side >= T::ZERO;
-        outside &= side <= T::ZERO;
-        let length2 = edge.dot(edge);
-        let u = if length2 > T::ZERO { ((x - *q).dot(edge) / length2).max(T::ZERO).min(T::ONE) } else { T::ZERO };
-        nearest = nearest.min((x - (*q + edge.scale(u))).norm());
-    }
-    if inside || outside {
-        height.abs()
-    } else {
-        nearest
-    }
 }
 
 #[cfg(test)]

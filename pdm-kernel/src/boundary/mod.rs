@@ -414,7 +414,7 @@ where
     if !(length > T::ZERO) {
         return None;
     }
-    shell_flat_events(outer, map_corners(map, r), n.scale(T::ONE / length), &occluder)
+    shell_flat_events(outer, (map, r), n.scale(T::ONE / length), &occluder)
 }
 
 /// The corners of the parallelogram with affine map (o, e_t, e_s) over `r`, in order around it.

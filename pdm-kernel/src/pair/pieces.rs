@@ -2,7 +2,8 @@
 //! pieces, every pair of pieces dispatched on its own.
 
 use super::*;
-use crate::singular::{adjacency_tolerance, corner_points};
+use crate::samples::Ball;
+use crate::singular::{adjacency_tolerance, closest_on_line, corner_points};
 use crate::surface::ParamRect;
 use crate::visibility::Occluder;
 
@@ -25,25 +26,38 @@ where
     O: Occluder<T> + ?Sized,
 {
     let ((ma, na), (mb, nb)) = (pieces(a), pieces(b));
-    if ma * na * mb * nb == 1 && contact_cuts(a, b, occluders).is_none() {
-        return f(a, b);
+    if ma * na * mb * nb == 1 {
+        return each_cut_pair(a, b, occluders, &mut f);
     }
     let (ra, rb) = (a.rect(), b.rect());
     for i in 0..ma * na {
         let pa = Patch::new(a.surface(), ra.cell(i / na, i % na, ma, na))?;
         for j in 0..mb * nb {
             let pb = Patch::new(b.surface(), rb.cell(j / nb, j % nb, mb, nb))?;
-            match contact_cuts(&pa, &pb, occluders) {
-                None => f(&pa, &pb)?,
-                Some((ca, cb)) => {
-                    for x in ca.rects() {
-                        let xa = Patch::new(pa.surface(), x)?;
-                        for y in cb.rects() {
-                            f(&xa, &Patch::new(pb.surface(), y)?)?;
-                        }
-                    }
-                }
-            }
+            each_cut_pair(&pa, &pb, occluders, &mut f)?;
+        }
+    }
+    Ok(())
+}
+
+/// Calls `f` on a piece pair, or on the pairs of its cells where [`contact_cuts`] cuts it.
+fn each_cut_pair<'s, 'r, T, SA, SB, O>(
+    a: &Patch<'s, T, SA>,
+    b: &Patch<'r, T, SB>,
+    occluders: &O,
+    f: &mut impl FnMut(&Patch<'s, T, SA>, &Patch<'r, T, SB>) -> Result<(), PdmError>,
+) -> Result<(), PdmError>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+    O: Occluder<T> + ?Sized,
+{
+    let Some((ca, cb)) = contact_cuts(a, b, occluders) else { return f(a, b) };
+    for x in ca.rects() {
+        let xa = Patch::new(a.surface(), x)?;
+        for y in cb.rects() {
+            f(&xa, &Patch::new(b.surface(), y)?)?;
         }
     }
     Ok(())
@@ -95,12 +109,9 @@ pub(crate) struct Cuts<T> {
 
 impl<T: Real> Cuts<T> {
     fn new(r: ParamRect<T>) -> Self {
-        Self {
-            t: [r.t0, r.t1, r.t1, r.t1, r.t1, r.t1, r.t1, r.t1],
-            nt: 2,
-            s: [r.s0, r.s1, r.s1, r.s1, r.s1, r.s1, r.s1, r.s1],
-            ns: 2,
-        }
+        let (mut t, mut s) = ([r.t1; MAX_CUTS + 2], [r.s1; MAX_CUTS + 2]);
+        (t[0], s[0]) = (r.t0, r.s0);
+        Self { t, nt: 2, s, ns: 2 }
     }
 
     /// Inserts `x` among the bounds `v[..n]` if it lies inside them, farther than `MIN_CUT` of
@@ -108,7 +119,7 @@ impl<T: Real> Cuts<T> {
     fn insert(v: &mut [T; MAX_CUTS + 2], n: &mut usize, x: T) {
         let (Some(&lo), Some(&hi)) = (v.first(), v.get(n.saturating_sub(1))) else { return };
         let gap = (hi - lo) * T::from_f64(MIN_CUT);
-        if *n >= v.len() || !(x > lo + gap && x < hi - gap) {
+        if !(x > lo + gap && x < hi - gap) {
             return;
         }
         let k = v.iter().take(*n).position(|&b| b >= x).unwrap_or(*n);
@@ -116,19 +127,14 @@ impl<T: Real> Cuts<T> {
         if k == 0 || near(k) || near(k - 1) {
             return;
         }
-        let mut i = *n;
-        while i > k {
-            if let (Some(&prev), true) = (v.get(i - 1), i < v.len()) {
-                if let Some(slot) = v.get_mut(i) {
-                    *slot = prev;
-                }
+        // v[k..=n] moved up by one (v[n] is a spare copy of the last bound), x into v[k].
+        if let Some(tail) = v.get_mut(k..=*n) {
+            tail.rotate_right(1);
+            if let Some(first) = tail.first_mut() {
+                *first = x;
             }
-            i -= 1;
+            *n += 1;
         }
-        if let Some(slot) = v.get_mut(k) {
-            *slot = x;
-        }
-        *n += 1;
     }
 
     fn cut_t(&mut self, x: T) {
@@ -189,22 +195,17 @@ where
             c.cut_s(r.s1);
         }
     } else {
-        let (ba, bb) = (contact_ball(a), contact_ball(b));
+        let (sa, sb) = (straight(a), straight(b));
+        let (ba, bb) = (contact_ball(a, sa), contact_ball(b, sb));
         let reach = (ba.radius + bb.radius) * T::from_f64(1.25);
         if !((ba.center - bb.center).norm() <= reach) {
             return None;
         }
-        #[cfg(feature = "closed-form")]
-        if a.surface().straight_corners(ra).is_some()
-            && b.surface().straight_corners(rb).is_some()
-            && !occluders.may_block_between(&ba, &bb)
-        {
+        if sa.is_some() && sb.is_some() && !occluders.may_block_between(&ba, &bb) {
             return None;
         }
-        #[cfg(not(feature = "closed-form"))]
-        let _ = occluders;
-        corners_on_edges(a, &corner_points(b), &mut ca);
-        corners_on_edges(b, &corner_points(a), &mut cb);
+        corners_on_edges(a, sa, &corner_points(b), &mut ca);
+        corners_on_edges(b, sb, &corner_points(a), &mut cb);
     }
     (ca.count() > 1 || cb.count() > 1).then_some((ca, cb))
 }
@@ -239,24 +240,32 @@ where
         && ga.normal(tm, sm).dot(gb.normal(tm, sm)) > T::ZERO
 }
 
-/// A ball holding the patch for the contact test of [`contact_cuts`]: a flat patch's with
-/// straight edges from its corners (exact for a convex polygon), else
-/// [`Patch::enclosing_ball`].
-fn contact_ball<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>) -> crate::samples::Ball<T> {
+/// The corners of a flat patch with straight edges ([`Surface::straight_corners`]); `None`
+/// for any other, and without the `closed-form` feature.
+fn straight<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>) -> Option<[Vec3<T>; 4]> {
     #[cfg(feature = "closed-form")]
-    if let Some(c) = p.surface().straight_corners(p.rect()) {
-        let center = c.iter().fold(Vec3::ZERO, |s, x| s + *x).scale(T::from_f64(0.25));
-        let radius = c.iter().fold(T::ZERO, |m, x| m.max((*x - center).norm()));
-        return crate::samples::Ball { center, radius };
+    return p.surface().straight_corners(p.rect());
+    #[cfg(not(feature = "closed-form"))]
+    {
+        let _ = p;
+        None
     }
-    p.enclosing_ball()
+}
+
+/// A ball holding the patch for the contact test of [`contact_cuts`]: from the corners of a
+/// flat patch with straight edges (`straight`; exact for a convex polygon), else
+/// [`Patch::enclosing_ball`].
+fn contact_ball<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>, straight: Option<[Vec3<T>; 4]>) -> Ball<T> {
+    let Some(c) = straight else { return p.enclosing_ball() };
+    let center = c.iter().fold(Vec3::ZERO, |s, x| s + *x).scale(T::from_f64(0.25));
+    let radius = c.iter().fold(T::ZERO, |m, x| m.max((*x - center).norm()));
+    Ball { center, radius }
 }
 
 /// [`corners_on_edges`] for a flat patch with straight edges (`straight`, its corners in
 /// order): each corner's foot on each edge's segment in closed form, the cut where it lies
 /// inside the segment within the tolerance and the patch's own point at that parameter (the
 /// parameterisation along a straight edge need not be linear) is within it too.
-#[cfg(feature = "closed-form")]
 fn corners_on_straight_edges<T, S>(
     p: &Patch<'_, T, S>,
     straight: [Vec3<T>; 4],
@@ -301,22 +310,25 @@ fn corners_on_straight_edges<T, S>(
 const EDGE_SAMPLES: usize = 17;
 
 /// Cuts `p` where one of `corners` lies on one of its edges, strictly between the edge's ends
-/// (within `adjacency_tolerance` of the edge's length, as `classify` matches corners): the
-/// nearest of `EDGE_SAMPLES` points along the edge, then a golden-section search between its
-/// neighbours for the nearest point. A corner farther from every sample than half the largest
-/// sample spacing (plus the tolerance) cannot lie on the edge and costs no search.
-fn corners_on_edges<T, S>(p: &Patch<'_, T, S>, corners: &[Vec3<T>; 4], cuts: &mut Cuts<T>)
-where
+/// (within `adjacency_tolerance` of the edge's length, as `classify` matches corners): in
+/// closed form for straight edges (`straight`, [`corners_on_straight_edges`]); else the
+/// nearest of `EDGE_SAMPLES` points along the edge, then the nearest point between its
+/// neighbours ([`closest_on_line`]). A corner farther from every sample than half the largest
+/// sample spacing (plus the tolerance), or at an end of the edge, costs no search.
+fn corners_on_edges<T, S>(
+    p: &Patch<'_, T, S>,
+    straight: Option<[Vec3<T>; 4]>,
+    corners: &[Vec3<T>; 4],
+    cuts: &mut Cuts<T>,
+) where
     T: Real,
     S: Surface<T> + ?Sized,
 {
-    let r = p.rect();
-    let g = p.surface();
-    #[cfg(feature = "closed-form")]
-    if let Some(straight) = g.straight_corners(r) {
+    if let Some(straight) = straight {
         corners_on_straight_edges(p, straight, corners, cuts);
         return;
     }
+    let (r, g) = (p.rect(), p.surface());
     // (along t?, the fixed other parameter)
     for (along_t, fixed) in [(true, r.s0), (true, r.s1), (false, r.t0), (false, r.t1)] {
         let (lo, hi) = if along_t { (r.t0, r.t1) } else { (r.s0, r.s1) };
@@ -347,33 +359,14 @@ where
             else {
                 continue;
             };
-            // Farther than half a spacing from every sample, or at one of the edge's ends.
             let at_end = k == 0 || k + 1 == EDGE_SAMPLES;
             if !(d <= spacing * T::HALF + tolerance) || (at_end && d <= tolerance) {
                 continue;
             }
-            let (mut x0, mut x1) = (param(k.saturating_sub(1)), param((k + 1).min(EDGE_SAMPLES - 1)));
-            let distance = |u: T| (at(u) - c).norm();
-            // Golden-section search: the bracket shrinks by 0.618 a step; 60 steps take 1/8 of
-            // the edge below 1e-13 of it.
-            let phi = T::from_f64(0.618_033_988_749_894_9);
-            let (mut u1, mut u2) = (x1 - (x1 - x0) * phi, x0 + (x1 - x0) * phi);
-            let (mut f1, mut f2) = (distance(u1), distance(u2));
-            for _ in 0..60 {
-                if f1 <= f2 {
-                    x1 = u2;
-                    (u2, f2) = (u1, f1);
-                    u1 = x1 - (x1 - x0) * phi;
-                    f1 = distance(u1);
-                } else {
-                    x0 = u1;
-                    (u1, f1) = (u2, f2);
-                    u2 = x0 + (x1 - x0) * phi;
-                    f2 = distance(u2);
-                }
-            }
-            let (u, f) = if f1 <= f2 { (u1, f1) } else { (u2, f2) };
+            let (x0, x1) = (param(k.saturating_sub(1)), param((k + 1).min(EDGE_SAMPLES - 1)));
+            let (rho, f) = closest_on_line(c, &|rho: T| at(x0 + (x1 - x0) * rho));
             if f <= tolerance {
+                let u = x0 + (x1 - x0) * rho;
                 if along_t {
                     cuts.cut_t(u);
                 } else {

@@ -426,7 +426,7 @@ fn ratio<T: Real>(num: T, den: T) -> T {
 /// The parameter ρ ∈ [0, 1] where `line(ρ)` comes closest to `p` and that distance, by golden
 /// section (the distance along a patch's coordinate line is unimodal for the flat and gently
 /// curved pairs that need it; an approximate centre only shifts the grading).
-fn closest_on_line<T: Real>(p: Vec3<T>, line: &dyn Fn(T) -> Vec3<T>) -> (T, T) {
+pub(crate) fn closest_on_line<T: Real>(p: Vec3<T>, line: &dyn Fn(T) -> Vec3<T>) -> (T, T) {
     let d = |r: T| (line(r) - p).norm();
     let g = T::from_f64(0.381_966_011_250_105_1);
     let (mut lo, mut hi) = (T::ZERO, T::ONE);
