@@ -93,7 +93,7 @@ impl<T: Real> Concentric<T> {
 
 /// Whether two spheres share their centre to within rounding of their size and position: the
 /// plane tests and events hold only for a common centre.
-fn same_centre<T: Real>(a: &Ball<T>, b: &Ball<T>) -> bool {
+pub(super) fn same_centre<T: Real>(a: &Ball<T>, b: &Ball<T>) -> bool {
     let scale = a.radius + b.radius + a.center.norm();
     (a.center - b.center).norm() <= T::from_f64(16.0) * T::EPSILON * scale
 }
@@ -102,9 +102,21 @@ fn same_centre<T: Real>(a: &Ball<T>, b: &Ball<T>) -> bool {
 /// test's, [`angles`]) four corners and two circles for each of four edges.
 const MAX_CONCENTRIC_CURVES: usize = 2 * 12;
 
-/// The outer events of a concentric pair ([`TrigonometricEvents`] with room for its curves).
-pub(super) type ConcentricEvents<T> =
-    TrigonometricEvents<T, MAX_CONCENTRIC_CURVES, { 8 * MAX_CONCENTRIC_CURVES + 2 }, { 2 * MAX_CONCENTRIC_CURVES + 2 }>;
+/// Most quadric sections among a sphere cell's events (`sphere_flat::sphere_flat_events`: one
+/// cone per corner of a parallelogram).
+const MAX_QUADRATIC_CURVES: usize = 4;
+
+/// The outer events of a concentric pair, or of a sphere's cell around a parallelogram across
+/// a sphere (`sphere_flat`): [`TrigonometricEvents`] with room for their curves (in s, eight
+/// breaks per plane section; per quadric section eight on the t-edges and, with its
+/// tangencies, room for twelve more).
+pub(super) type ConcentricEvents<T> = TrigonometricEvents<
+    T,
+    MAX_CONCENTRIC_CURVES,
+    { 8 * MAX_CONCENTRIC_CURVES + 20 * MAX_QUADRATIC_CURVES + 2 },
+    { 2 * MAX_CONCENTRIC_CURVES + 4 * MAX_QUADRATIC_CURVES + 2 },
+    MAX_QUADRATIC_CURVES,
+>;
 
 /// cos ψₖ of the boundaries of the visible part of b's sphere (radius `rb`) from a point of
 /// a's (radius `ra`; module docs): the occluder's where there is one, and the facing tests'

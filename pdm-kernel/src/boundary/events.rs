@@ -631,6 +631,150 @@ fn piece<T: Real>(
     Ok(total)
 }
 
+/// The least value over the rectangle `r` of f(t, s) = a + b·cos t + c(s)·sin t (`curve` in
+/// [`Surface::facing_across_s`]'s form, a and b constant in s): at a corner, on an edge where
+/// its first-degree trigonometric restriction turns, or inside where both derivatives vanish
+/// (c'(s) = 0 and tan t = c(s)/b); T::MAX's negative, −∞ in effect, where a or b varies.
+pub(super) fn trigonometric_least<T: Real>([a, b, c]: [[T; 3]; 3], r: ParamRect<T>) -> T {
+    let constant = |k: [T; 3]| k[1] == T::ZERO && k[2] == T::ZERO;
+    if !constant(a) || !constant(b) {
+        return -T::MAX;
+    }
+    let f = |t: T, s: T| {
+        let (st, ct) = t.sin_cos();
+        let (ss, cs) = s.sin_cos();
+        a[0] + b[0] * ct + (c[0] + c[1] * cs + c[2] * ss) * st
+    };
+    // Turning points of k₀ + k_c·cos x + k_s·sin x: x = atan2(k_s, k_c) + jπ.
+    let turns = |kc: T, ks: T, lo: T, hi: T, out: &mut dyn FnMut(T)| {
+        let base = ks.atan2(kc);
+        for j in -4i32..=4 {
+            let x = base + T::PI * T::from_f64(f64::from(j));
+            if x > lo && x < hi {
+                out(x);
+            }
+        }
+    };
+    let mut least = T::MAX;
+    for (t, s) in [(r.t0, r.s0), (r.t1, r.s0), (r.t0, r.s1), (r.t1, r.s1)] {
+        least = least.min(f(t, s));
+    }
+    for te in [r.t0, r.t1] {
+        // Along the edge: a + b·cos tₑ + sin tₑ·(k₀ + k_c·cos s + k_s·sin s).
+        let st = te.sin();
+        turns(c[1] * st, c[2] * st, r.s0, r.s1, &mut |s| least = least.min(f(te, s)));
+    }
+    let along_t = |s: T, least: &mut T| {
+        let (ss, cs) = s.sin_cos();
+        let cs_value = c[0] + c[1] * cs + c[2] * ss;
+        turns(b[0], cs_value, r.t0, r.t1, &mut |t| *least = least.min(f(t, s)));
+    };
+    for se in [r.s0, r.s1] {
+        along_t(se, &mut least);
+    }
+    turns(c[1], c[2], r.s0, r.s1, &mut |s| along_t(s, &mut least));
+    least
+}
+
+/// Whether L₁² − L₂ = 0 may hold somewhere in `r`: the ranges of L₁ and L₂ over it
+/// ([`trigonometric_least`] of each and of its negative) allow L₁² = L₂.
+fn may_meet<T: Real>([l1, l2]: [Trigonometric<T>; 2], r: ParamRect<T>) -> bool {
+    let negative = |l: Trigonometric<T>| l.map(|k| k.map(|x| -x));
+    let (lo1, hi1) = (trigonometric_least(l1, r), -trigonometric_least(negative(l1), r));
+    let (lo2, hi2) = (trigonometric_least(l2, r), -trigonometric_least(negative(l2), r));
+    let least_square = if lo1 <= T::ZERO && hi1 >= T::ZERO { T::ZERO } else { (lo1 * lo1).min(hi1 * hi1) };
+    let most_square = (lo1 * lo1).max(hi1 * hi1);
+    // A margin of rounding on both comparisons: a curve kept wrongly costs breaks only.
+    let slack = T::from_f64(64.0) * T::EPSILON * (most_square + hi2.abs().max(lo2.abs()));
+    !(least_square > hi2 + slack || most_square + slack < lo2)
+}
+
+/// Samples along s at which [`meridian_tangencies`] counts a curve's crossings of the t-lines.
+const TANGENCY_SAMPLES: usize = 48;
+
+/// The s in (r.s0, r.s1) where the curve L₁² − L₂ = 0 on a sphere touches a t-line at a t in
+/// [r.t0, r.t1]: there the part of a line on one side grows like √(s − s*), a singular end the
+/// outer rule is graded towards. Each t-line extended to its whole great circle (t over a full
+/// turn) crosses the curve an even number of times, which changes only where the curve touches
+/// it; the count is taken at [`TANGENCY_SAMPLES`] values of s and each change bisected to
+/// rounding, its t the middle of the two crossings nearest each other just past it. (A curve
+/// that touches two t-lines between neighbouring samples, a loop narrower than the spacing,
+/// gives no break: its outer rule converges more slowly there.)
+fn meridian_tangencies<T: Real>(
+    [l1, l2]: [Trigonometric<T>; 2],
+    r: ParamRect<T>,
+    out: &mut dyn FnMut(T),
+) -> Result<(), PdmError> {
+    const MOST: usize = 64;
+    let crossings = |s: T, roots: &mut [T; MOST]| -> Result<usize, PdmError> {
+        let (ss, cs) = s.sin_cos();
+        let at = |k: [T; 3]| k[0] + k[1] * cs + k[2] * ss;
+        let along = |[a, b, c]: Trigonometric<T>| [at(a), at(b), at(c)];
+        let mut n = 0usize;
+        let complete = squared_trigonometric_roots(along(l1), along(l2), -T::PI, T::PI, &mut |t| {
+            if let Some(slot) = roots.get_mut(n) {
+                *slot = t;
+                n += 1;
+            }
+        });
+        if !complete {
+            return Err(PdmError::NonFinite);
+        }
+        Ok(n)
+    };
+    let mut roots = [T::ZERO; MOST];
+    let width = r.s1 - r.s0;
+    let step = width / T::from_usize(TANGENCY_SAMPLES);
+    let mut prev = (r.s0, crossings(r.s0, &mut roots)?);
+    for k in 1..=TANGENCY_SAMPLES {
+        let s = if k == TANGENCY_SAMPLES { r.s1 } else { r.s0 + step * T::from_usize(k) };
+        let here = (s, crossings(s, &mut roots)?);
+        if here.1 != prev.1 {
+            let (mut lo, mut hi) = (prev, here);
+            let resolution = width * T::from_f64(1e-12);
+            for _ in 0..(T::MANTISSA_DIGITS + 4) {
+                let mid = (lo.0 + hi.0) * T::HALF;
+                if !(mid > lo.0 && mid < hi.0) || hi.0 - lo.0 <= resolution {
+                    break;
+                }
+                let count = crossings(mid, &mut roots)?;
+                if count == lo.1 {
+                    lo = (mid, count);
+                } else {
+                    hi = (mid, count);
+                }
+            }
+            // The side with more crossings: the two nearest each other (around the circle)
+            // are the pair that meets at the tangency.
+            let richer = if hi.1 > lo.1 { hi.0 } else { lo.0 };
+            let n = crossings(richer, &mut roots)?;
+            let found = roots.get_mut(..n).unwrap_or_default();
+            sort(found);
+            let mut best: Option<(T, T)> = None;
+            for (i, &x) in found.iter().enumerate() {
+                let (next, wrap) = match found.get(i + 1) {
+                    Some(&y) => (y, T::ZERO),
+                    None => (found.first().copied().unwrap_or(x), T::TWO * T::PI),
+                };
+                let gap = next + wrap - x;
+                if n > 1 && best.is_none_or(|(g, _)| gap < g) {
+                    best = Some((gap, x + gap * T::HALF));
+                }
+            }
+            let margin = (r.t1 - r.t0) * T::from_f64(1e-6);
+            let on_cell = |t: T| {
+                let turn = T::TWO * T::PI;
+                [t - turn, t, t + turn].iter().any(|&t| t >= r.t0 - margin && t <= r.t1 + margin)
+            };
+            if best.is_none_or(|(_, t)| on_cell(t)) {
+                out((lo.0 + hi.0) * T::HALF);
+            }
+        }
+        prev = here;
+    }
+    Ok(())
+}
+
 /// A curve on a curved outer patch: f(t, s) = a(s) + b(s)·cos t + c(s)·sin t = 0, each of a, b,
 /// c as `[k₀, k_c, k_s]` for k₀ + k_c·cos s + k_s·sin s ([`Surface::facing_across_s`]'s form),
 /// with a and b constant in s (c(s) = ±√(a² − b²) then gives the tangencies in closed form).
@@ -657,12 +801,18 @@ const MAX_TRIGONOMETRIC_S_BREAKS: usize = 8 * MAX_TRIGONOMETRIC_CURVES + 2;
 /// Generic over its capacity: `N` curves, `S` breaks in s and `TB` along a t-line (ends
 /// included); [`SphereCellEvents`] for these, `concentric::ConcentricEvents` for a pair across
 /// a concentric sphere occluder, whose curves are also plane sections of the outer sphere.
-pub(super) struct TrigonometricEvents<T, const N: usize, const S: usize, const TB: usize> {
+pub(super) struct TrigonometricEvents<T, const N: usize, const S: usize, const TB: usize, const Q: usize = 0> {
     curves: [Trigonometric<T>; N],
     /// Whether the rule along a t-line is graded towards the curve's roots (a 3/2-power point
     /// of J where a boundary touches an edge of b), per curve.
     graded: [bool; N],
     n: usize,
+    /// Curves L₁² − L₂ = 0 with L₁, L₂ in the form above: a quadric's section of the outer
+    /// sphere whose equation on the sphere reduces to that (a cone tangent to a sphere
+    /// occluder from a corner of b: [`TrigonometricEvents::push_quadratic`]); the rule along
+    /// the t-lines is graded towards their roots.
+    quadratics: [[Trigonometric<T>; 2]; Q],
+    nq: usize,
 }
 
 /// The events of a sphere's cell against a parallelogram ([`TrigonometricEvents::new`]).
@@ -696,10 +846,46 @@ impl<T: Real> SphereCellEvents<T> {
     }
 }
 
-impl<T: Real, const N: usize, const S: usize, const TB: usize> TrigonometricEvents<T, N, S, TB> {
+impl<T: Real, const N: usize, const S: usize, const TB: usize, const Q: usize> TrigonometricEvents<T, N, S, TB, Q> {
     /// No curves yet.
     pub(super) fn empty() -> Self {
-        Self { curves: [[[T::ZERO; 3]; 3]; N], graded: [false; N], n: 0 }
+        Self {
+            curves: [[[T::ZERO; 3]; 3]; N],
+            graded: [false; N],
+            n: 0,
+            quadratics: [[[[T::ZERO; 3]; 3]; 2]; Q],
+            nq: 0,
+        }
+    }
+
+    /// Keeps the curve L₁² − L₂ = 0 (each in [`Surface::facing_across_s`]'s form), scaled so
+    /// that its larger side's largest coefficient is 1; `None` where it is not finite, a or b
+    /// of either varies with s, or the buffer is full.
+    pub(super) fn push_quadratic(&mut self, l1: Trigonometric<T>, l2: Trigonometric<T>) -> Option<()> {
+        let constant = |k: [T; 3]| k[1] == T::ZERO && k[2] == T::ZERO;
+        for [a, b, _] in [l1, l2] {
+            if !constant(a) || !constant(b) {
+                return None;
+            }
+        }
+        let all = l1.iter().chain(l2.iter()).flatten();
+        if !all.clone().all(|x| x.is_finite()) {
+            return None;
+        }
+        let largest = |l: &Trigonometric<T>| l.iter().flatten().fold(T::ZERO, |m, x| m.max(x.abs()));
+        let (k1, k2) = (largest(&l1), largest(&l2));
+        let scale = (k1 * k1).max(k2);
+        if !(scale > T::ZERO) || !scale.is_finite() {
+            return None;
+        }
+        let root = scale.sqrt();
+        *self.quadratics.get_mut(self.nq)? = [l1.map(|k| k.map(|x| x / root)), l2.map(|k| k.map(|x| x / scale))];
+        self.nq += 1;
+        Some(())
+    }
+
+    fn used_quadratics(&self) -> &[[Trigonometric<T>; 2]] {
+        self.quadratics.get(..self.nq).unwrap_or_default()
     }
 
     /// Keeps a curve scaled to its largest coefficient 1, with the rule along the t-lines
@@ -757,10 +943,28 @@ impl<T: Real, const N: usize, const S: usize, const TB: usize> TrigonometricEven
                 }
             }
         }
+        let mut active = [false; Q];
+        for (&[l1, l2], on) in self.used_quadratics().iter().zip(active.iter_mut()) {
+            *on = may_meet([l1, l2], r);
+            if !*on {
+                continue;
+            }
+            for te in [r.t0, r.t1] {
+                let (st, ct) = te.sin_cos();
+                let at_edge = |[a, b, c]: Trigonometric<T>| [a[0] + b[0] * ct + c[0] * st, c[1] * st, c[2] * st];
+                if !squared_trigonometric_roots(at_edge(l1), at_edge(l2), r.s0, r.s1, &mut |s| add(s)) {
+                    return Err(PdmError::NonFinite);
+                }
+            }
+            meridian_tangencies([l1, l2], r, &mut |s| {
+                add(s);
+                place(s, r.s0, r.s1, &mut tangencies, &mut nt);
+            })?;
+        }
         add(r.s1);
         let tangencies = tangencies.get(..nt).unwrap_or_default();
         let grade = |x: T| tangencies.contains(&x);
-        sum_pieces(breaks.get_mut(..n).unwrap_or_default(), rule, &grade, &mut |s| self.line(r, s, rule, f))
+        sum_pieces(breaks.get_mut(..n).unwrap_or_default(), rule, &grade, &mut |s| self.line(r, s, &active, rule, f))
     }
 
     /// ∫ f(t, s) dt over [r.t0, r.t1] at one s, with breaks at the curves' roots.
@@ -768,6 +972,7 @@ impl<T: Real, const N: usize, const S: usize, const TB: usize> TrigonometricEven
         &self,
         r: ParamRect<T>,
         s: T,
+        active: &[bool; Q],
         rule: &GaussRule<T>,
         f: &mut dyn FnMut(T, T) -> Result<T, PdmError>,
     ) -> Result<T, PdmError> {
@@ -786,6 +991,15 @@ impl<T: Real, const N: usize, const S: usize, const TB: usize> TrigonometricEven
                     place(t, r.t0, r.t1, &mut graded, &mut ng);
                 }
             });
+        }
+        for (&[l1, l2], _) in self.used_quadratics().iter().zip(active).filter(|(_, &on)| on) {
+            let along = |[a, b, c]: Trigonometric<T>| [at(a), at(b), at(c)];
+            if !squared_trigonometric_roots(along(l1), along(l2), r.t0, r.t1, &mut |t| {
+                place(t, r.t0, r.t1, &mut breaks, &mut n);
+                place(t, r.t0, r.t1, &mut graded, &mut ng);
+            }) {
+                return Err(PdmError::NonFinite);
+            }
         }
         place(r.t1, r.t0, r.t1, &mut breaks, &mut n);
         // Kinks with smooth sides (δ³ at a sphere cell's corner circle, linear at a plane's)

@@ -356,6 +356,85 @@ pub(super) fn trigonometric_roots<T: Real>(f: [T; 3], t0: T, t1: T, out: &mut im
     true
 }
 
+/// The roots in (t0, t1) where (a₁ + b₁·cos t + c₁·sin t)² − (a₂ + b₂·cos t + c₂·sin t)
+/// changes sign (`l1`, `l2` as `[a, b, c]`): a second-degree trigonometric polynomial, with at
+/// most four roots per period. On pieces of at most a quarter turn about their middle m, the
+/// half-angle substitution x = tan((t − m)/2) makes (1 + x²)² times it a quartic in x
+/// (x within ±tan(π/8)), whose sign changes [`roots_in_interval`] brackets; each root is
+/// polished by Newton steps on the trigonometric form. A double root (a tangency) does not
+/// change the sign and is not passed. `false` where a coefficient or an end is not finite or
+/// the range spans more than 60 periods.
+#[cfg(feature = "closed-form")]
+pub(super) fn squared_trigonometric_roots<T: Real>(
+    l1: [T; 3],
+    l2: [T; 3],
+    t0: T,
+    t1: T,
+    out: &mut dyn FnMut(T),
+) -> bool {
+    if !l1.iter().chain(l2.iter()).all(|x| x.is_finite()) || !t0.is_finite() || !t1.is_finite() {
+        return false;
+    }
+    if !(t1 > t0) {
+        return true;
+    }
+    if (t1 - t0) > T::from_usize(60) * T::TWO * T::PI {
+        return false;
+    }
+    let [a1, b1, c1] = l1;
+    let [a2, b2, c2] = l2;
+    let f = |t: T| {
+        let (st, ct) = t.sin_cos();
+        let l = a1 + b1 * ct + c1 * st;
+        (l * l - (a2 + b2 * ct + c2 * st), T::TWO * l * (c1 * ct - b1 * st) - (c2 * ct - b2 * st))
+    };
+    let quarter = T::PI * T::HALF;
+    let mut lo = t0;
+    // At most 4·60 + 1 pieces (the range is checked above).
+    for _ in 0..242 {
+        if !(lo < t1) {
+            break;
+        }
+        let hi = (lo + quarter).min(t1);
+        let (m, h) = ((lo + hi) * T::HALF, (hi - lo) * T::HALF);
+        let (sm, cm) = m.sin_cos();
+        // L(m + τ) = a + (b·cos m + c·sin m)·cos τ + (c·cos m − b·sin m)·sin τ, and with
+        // x = tan(τ/2): (1 + x²)·L = (a + b') + 2c'·x + (a − b')·x².
+        let half_angle = |[a, b, c]: [T; 3]| {
+            let (b, c) = (b * cm + c * sm, c * cm - b * sm);
+            [a + b, T::TWO * c, a - b]
+        };
+        let (q1, q2) = (half_angle(l1), half_angle(l2));
+        let square = square(&q1);
+        let linear = product(&q2, &[T::ONE, T::ZERO, T::ONE]);
+        let mut quartic = [T::ZERO; 5];
+        for ((q, s), l) in quartic.iter_mut().zip(square).zip(linear) {
+            *q = s - l;
+        }
+        let (sh, ch) = (h * T::HALF).sin_cos();
+        let end = sh / ch;
+        roots_in_interval(&quartic, -end, end, &mut |x| {
+            let mut root = m + T::TWO * x.atan();
+            for _ in 0..2 {
+                let (value, slope) = f(root);
+                if !(slope.abs() > T::ZERO) {
+                    break;
+                }
+                let next = root - value / slope;
+                if !(next.is_finite() && next > lo && next < hi && f(next).0.abs() <= value.abs()) {
+                    break;
+                }
+                root = next;
+            }
+            if root > t0 && root < t1 {
+                out(root);
+            }
+        });
+        lo = hi;
+    }
+    true
+}
+
 /// (q(x))² for a quadratic q, as quartic coefficients (ascending powers).
 pub(super) fn square<T: Real>(q: &[T; 3]) -> [T; 5] {
     product(q, q)
@@ -451,15 +530,84 @@ mod tests {
     /// Every sign change of a + b·cos t + c·sin t on a fine grid over (t0, t1) holds a root the
     /// closed form reports, and every reported root is one (|f| at rounding level), over
     /// random coefficients and ranges of up to three periods, near-tangent cases included.
-    #[test]
-    fn trigonometric_roots_are_every_sign_change() {
-        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut next = move || {
+    /// A xorshift stream of numbers uniform in [−1, 1) from `state`.
+    fn uniform(mut state: u64) -> impl FnMut() -> f64 {
+        move || {
             state ^= state << 13;
             state ^= state >> 7;
             state ^= state << 17;
             (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
+        }
+    }
+
+    /// The sign changes of `f` on a grid of 20 000 steps over (t0, t1), each asserted to hold
+    /// one of `roots` (case `k` in the message).
+    fn sign_changes_have_roots(f: &dyn Fn(f64) -> f64, t0: f64, t1: f64, roots: &[f64], k: usize) -> usize {
+        let n = 20_000;
+        let mut changes = 0;
+        let mut prev = f(t0);
+        for i in 1..=n {
+            let x = t0 + (t1 - t0) * i as f64 / n as f64;
+            let y = f(x);
+            if (prev > 0.0) != (y > 0.0) && prev != 0.0 && y != 0.0 {
+                let lo = x - (t1 - t0) / n as f64;
+                assert!(
+                    roots.iter().any(|&r| r >= lo - 1e-9 && r <= x + 1e-9),
+                    "k = {k}: sign change in [{lo}, {x}] without a root ({roots:?})"
+                );
+                changes += 1;
+            }
+            prev = y;
+        }
+        changes
+    }
+
+    /// Every sign change of (a₁ + b₁ cos t + c₁ sin t)² − (a₂ + b₂ cos t + c₂ sin t) on a fine
+    /// grid has a root of `squared_trigonometric_roots` within it, each root is one to rounding,
+    /// and ranges over many periods and near-tangent cases are covered.
+    #[test]
+    fn squared_trigonometric_roots_are_every_sign_change() {
+        let mut next = uniform(0x2545_f491_4f6c_dd1d_u64);
+        let mut changes = 0;
+        for k in 0..2000 {
+            let l1 = [next() * 2.0, next() * 2.0, next() * 2.0];
+            let mut l2 = [next() * 3.0, next() * 3.0, next() * 3.0];
+            if k % 4 == 0 {
+                // Near a double root: shift the constant so that f has a minimum near 0.
+                let f = |t: f64| {
+                    let l = l1[0] + l1[1] * t.cos() + l1[2] * t.sin();
+                    l * l - (l2[0] + l2[1] * t.cos() + l2[2] * t.sin())
+                };
+                let t = next() * 3.0;
+                l2[0] += f(t) * (1.0 + 1e-4 * next());
+            }
+            let t0 = next() * 8.0;
+            let t1 = t0 + 0.05 + next().abs() * 14.0;
+            let f = |t: f64| {
+                let l = l1[0] + l1[1] * t.cos() + l1[2] * t.sin();
+                l * l - (l2[0] + l2[1] * t.cos() + l2[2] * t.sin())
+            };
+            let scale = 1.0 + l1.iter().map(|x| x * x).sum::<f64>() + l2.iter().map(|x| x.abs()).sum::<f64>();
+            let (mut found, mut count) = ([0.0_f64; 128], 0usize);
+            assert!(squared_trigonometric_roots(l1, l2, t0, t1, &mut |t| {
+                found[count] = t;
+                count += 1;
+            }));
+            let roots = &found[..count];
+            for &t in roots {
+                assert!(t > t0 && t < t1);
+                assert!(f(t).abs() <= 1e-11 * scale, "k = {k}: f({t}) = {}", f(t));
+            }
+            changes += sign_changes_have_roots(&f, t0, t1, roots, k);
+        }
+        assert!(changes > 2000, "{changes}");
+        assert!(!squared_trigonometric_roots([f64::NAN, 1.0, 0.0], [0.0; 3], 0.0, 1.0, &mut |_| {}));
+        assert!(!squared_trigonometric_roots([1.0, 1.0, 0.0], [0.0; 3], 0.0, 1e6, &mut |_| {}));
+    }
+
+    #[test]
+    fn trigonometric_roots_are_every_sign_change() {
+        let mut next = uniform(0x9e37_79b9_7f4a_7c15_u64);
         let mut changes = 0;
         for k in 0..3000 {
             let (b, c) = (next() * 3.0, next() * 3.0);
@@ -480,21 +628,7 @@ mod tests {
                 assert!(t > t0 && t < t1);
                 assert!(f(t).abs() <= 1e-12 * (a.abs() + rho), "k = {k}: f({t}) = {}", f(t));
             }
-            let n = 20_000;
-            let mut prev = f(t0);
-            for i in 1..=n {
-                let x = t0 + (t1 - t0) * i as f64 / n as f64;
-                let y = f(x);
-                if (prev > 0.0) != (y > 0.0) && prev != 0.0 && y != 0.0 {
-                    let lo = x - (t1 - t0) / n as f64;
-                    assert!(
-                        roots.iter().any(|&r| r >= lo - 1e-9 && r <= x + 1e-9),
-                        "k = {k}: sign change in [{lo}, {x}] without a root ({roots:?})"
-                    );
-                    changes += 1;
-                }
-                prev = y;
-            }
+            changes += sign_changes_have_roots(&f, t0, t1, roots, k);
         }
         assert!(changes > 3000);
         // Scaled coefficients: the same roots at 1e-30 and 1e30 in f32 as at 1.

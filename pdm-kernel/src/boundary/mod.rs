@@ -58,7 +58,13 @@
 //! the same centre, across a sphere occluder with that centre or none, has only circles about
 //! the centre for boundaries: its events are plane sections of the outer sphere, placed the
 //! same way (`concentric.rs`; an octant's row inside a sphere around a concentric one against
-//! the closed form 1 − (r/R)², `tests/integration/tests/adaptive.rs`). Elsewhere the outer rule samples across
+//! the closed form 1 − (r/R)², `tests/integration/tests/adaptive.rs`). A sphere's cell against a
+//! parallelogram in front of all its tangent planes, across one sphere occluder anywhere, has
+//! the occluder's tangent planes through b's edges (circles) and per corner of b the cone from
+//! it tangent to the occluder, which meets a's sphere in a curve L₁² = L₂ with L₁, L₂ plane
+//! tests: a second-degree trigonometric polynomial along each meridian, its crossings and
+//! tangencies found by a quartic (`sphere_flat.rs`; orders 12 and 20 within 1e-11,
+//! `general_geometry::sphere_cells_against_parallelograms_across_a_sphere_anywhere`). Elsewhere the outer rule samples across
 //! them (algebraic convergence), which patch grids (and the outer split in [`crate::pair`])
 //! reduce.
 //!
@@ -130,6 +136,8 @@ mod lines;
 mod polygon_events;
 #[cfg(feature = "closed-form")]
 mod shadows;
+#[cfg(feature = "closed-form")]
+mod sphere_flat;
 #[cfg(feature = "closed-form")]
 pub(crate) use blocked::Blocked;
 use breaks::*;
@@ -373,8 +381,8 @@ where
     let events = if inner.concentric.is_some() || !inner.use_occluders {
         concentric_events(surface, inner.surface, inner.r, inner.concentric.as_ref())
     } else if inner.parallelogram.is_some() && surface.on_sphere().is_some() {
-        let (from, part) = (a.enclosing_ball(), Patch::new(inner.surface, inner.r)?);
-        shell_flat_of(surface, &part, inner.parallelogram, true, inner.occluders, (&from, inner_bounds))
+        let part = Patch::new(inner.surface, inner.r)?;
+        shell_flat_of(a, &part, inner.parallelogram, true, inner.occluders, inner_bounds)
     } else {
         None
     };
@@ -387,17 +395,20 @@ where
     Ok(Some(total))
 }
 
-/// The outer events of a cell of a sphere against a parallelogram inside it across one sphere
-/// with the outer sphere's centre (`concentric::shell_flat_events`), for the patch `inner`
-/// (its surface's affine map `map`) seen from the ball `from`; `None` where they do not apply.
+/// The outer events of a cell of a sphere (`a`) against a parallelogram across one sphere
+/// occluder: inside the sphere around one with its centre (`concentric::shell_flat_events`,
+/// all circles), else anywhere the parallelogram lies in front of the cell's tangent planes
+/// (`sphere_flat::sphere_flat_events`, with a cone's section per corner); for the patch
+/// `inner` (its surface's affine map `map`, inside the ball `bounds`); `None` where they do
+/// not apply.
 #[cfg(feature = "closed-form")]
 fn shell_flat_of<T, SA, SB, O>(
-    outer: &SA,
+    a: &Patch<'_, T, SA>,
     inner: &Patch<'_, T, SB>,
     map: Option<(Vec3<T>, Vec3<T>, Vec3<T>)>,
     use_occluders: bool,
     occluders: &O,
-    (from, bounds): (&Ball<T>, &Ball<T>),
+    bounds: &Ball<T>,
 ) -> Option<ConcentricEvents<T>>
 where
     T: Real,
@@ -406,15 +417,24 @@ where
     O: Occluder<T> + ?Sized,
 {
     let map = map.filter(|_| use_occluders)?;
+    let outer = a.surface();
     outer.on_sphere()?;
-    let occluder = occluders.shadow_sphere(from, bounds)??;
+    let from = a.enclosing_ball();
+    let occluder = occluders.shadow_sphere(&from, bounds)??;
     let r = inner.rect();
-    let n = inner.surface().normal((r.t0 + r.t1) * T::HALF, (r.s0 + r.s1) * T::HALF);
+    let middle = |r: ParamRect<T>| ((r.t0 + r.t1) * T::HALF, (r.s0 + r.s1) * T::HALF);
+    let (tm, sm) = middle(r);
+    let n = inner.surface().normal(tm, sm);
     let length = n.norm();
     if !(length > T::ZERO) {
         return None;
     }
-    shell_flat_events(outer, (map, r), n.scale(T::ONE / length), &occluder)
+    let unit = n.scale(T::ONE / length);
+    shell_flat_events(outer, (map, r), unit, &occluder).or_else(|| {
+        let (ta, sa) = middle(a.rect());
+        let cell = (a.rect(), &from, outer.point(ta, sa), outer.normal(ta, sa));
+        sphere_flat::sphere_flat_events(outer, cell, (map, r), unit, &occluder)
+    })
 }
 
 /// The corners of the parallelogram with affine map (o, e_t, e_s) over `r`, in order around it.
@@ -598,10 +618,7 @@ where
                 };
                 concentric_events(outer.surface(), surface, r, concentric.as_ref()).map(|_| true)
             })
-            .or_else(|| {
-                let from = outer.enclosing_ball();
-                shell_flat_of(outer.surface(), inner, affine, use_occluders, occluders, (&from, &bounds)).map(|_| true)
-            }),
+            .or_else(|| shell_flat_of(outer, inner, affine, use_occluders, occluders, &bounds).map(|_| true)),
     }
 }
 
