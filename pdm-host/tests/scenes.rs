@@ -114,6 +114,61 @@ fn closed_cylinder_with_grids_that_do_not_match() {
     assert_eq!(r.diagnostics.pairs_unconverged, 0);
 }
 
+/// A closed frustum (bottom radius 1, top 0.4, height 1.5; its wall's inner side): the wall
+/// bounds a convex solid, so it cuts no segment between the disks or between a disk and
+/// itself, and no pair is integrated across it (it was taken as an occluder of every pair,
+/// and the scene did not finish in 300 s). Bottom → top by C-41, the rest by the sum rule
+/// and reciprocity.
+#[test]
+fn closed_frustum_against_c41_and_the_sum_rule() {
+    let s = scene(
+        r#"
+enclosure = true
+
+[[surface]]
+name = "bottom"
+kind = "disk"
+center = [0, 0, 0]
+normal = [0, 0, 1]
+radius = 1
+subdivide = [2, 4]
+
+[[surface]]
+name = "top"
+kind = "disk"
+center = [0, 0, 1.5]
+normal = [0, 0, -1]
+radius = 0.4
+subdivide = [1, 4]
+
+[[surface]]
+name = "wall"
+kind = "cone"
+base = [0, 0, 0]
+axis = [0, 0, 1]
+base_radius = 1
+top_radius = 0.4
+height = 1.5
+side = "inner"
+subdivide = [6, 3]
+"#,
+    );
+    let r = run(&s, PairMethod::tolerance(1e-7));
+    let (bottom, top) = (core::f64::consts::PI, core::f64::consts::PI * 0.16);
+    let wall = core::f64::consts::PI * 1.4 * (1.5f64 * 1.5 + 0.6 * 0.6).sqrt();
+    let up = closed_form::coaxial_disks(1.0, 0.4, 1.5); // C-41
+    let down = up * bottom / top;
+    check(&r, "bottom", "top", up, 1e-7);
+    check(&r, "top", "bottom", down, 1e-7);
+    check(&r, "bottom", "wall", 1.0 - up, 1e-7);
+    check(&r, "top", "wall", 1.0 - down, 1e-7);
+    let (to_bottom, to_top) = (bottom * (1.0 - up) / wall, top * (1.0 - down) / wall);
+    check(&r, "wall", "bottom", to_bottom, 1e-7);
+    check(&r, "wall", "wall", 1.0 - to_bottom - to_top, 1e-7);
+    assert!(r.diagnostics.enclosure_gaps.is_empty(), "{:?}", r.diagnostics.enclosure_gaps);
+    assert_eq!(r.diagnostics.pairs_unconverged, 0);
+}
+
 /// JSON reads into the same model: two coaxial disks of radii 1 and 2 at distance 1.5, the
 /// smaller one as an annulus sector pair (4 sectors) and the larger subdivided by rings.
 #[test]

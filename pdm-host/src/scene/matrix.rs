@@ -177,7 +177,16 @@ fn inside_solid(solid: &Geom, geom: &Geom, p: &ScenePatch, ball: (Vec3<f64>, f64
             };
             reach <= radius + tol
         }
-        Geom::Cylinder { base, frame, radius, height, .. } => {
+        // A tube (r₀ = r₁) or a cone or frustum bounds a convex solid: 0 ≤ z ≤ h along the axis,
+        // distance from the axis ≤ r(z) = r₀ + (r₁ − r₀)·z/h. A parallelogram is inside when
+        // its corners are; any other patch when its farthest reach from the axis stays within
+        // the smaller radius over its axial range (r is linear in z).
+        Geom::Cylinder { base, frame, radius: base_radius, height, .. }
+        | Geom::Cone { base, frame, base_radius, height, .. } => {
+            let top_radius = match *solid {
+                Geom::Cone { top_radius, .. } => top_radius,
+                _ => base_radius,
+            };
             let axial = Plane { origin: base, normal: frame.axis };
             let (lo, hi) = geom.distance_range(p.rect, &axial);
             if !(lo >= -tol && hi <= height + tol) {
@@ -187,14 +196,13 @@ fn inside_solid(solid: &Geom, geom: &Geom, p: &ScenePatch, ball: (Vec3<f64>, f64
                 let d = x - base;
                 (d - frame.axis.scale(d.dot(frame.axis))).norm()
             };
-            let reach = match *geom {
-                Geom::Parallelogram { origin, edge_t, edge_s } => {
-                    corners(origin, edge_t, edge_s, p.rect).map(radial).fold(0.0, f64::max)
-                }
-                Geom::Disk { center, outer, .. } => radial(center) + outer,
-                _ => radial(bc) + br,
-            };
-            reach <= radius + tol
+            let radius_at = |z: f64| base_radius + (top_radius - base_radius) * (z / height).clamp(0.0, 1.0);
+            match *geom {
+                Geom::Parallelogram { origin, edge_t, edge_s } => corners(origin, edge_t, edge_s, p.rect)
+                    .all(|x| radial(x) <= radius_at((x - base).dot(frame.axis)) + tol),
+                Geom::Disk { center, outer, .. } => radial(center) + outer <= radius_at(lo).min(radius_at(hi)) + tol,
+                _ => radial(bc) + br <= radius_at(lo).min(radius_at(hi)) + tol,
+            }
         }
         _ => false,
     }

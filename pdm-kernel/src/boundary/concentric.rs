@@ -45,9 +45,9 @@ use super::*;
 /// A sphere occluder with the centre of the sphere b lies on, inside it.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Concentric<T> {
-    center: Vec3<T>,
-    occluder: T,
-    radius: T,
+    pub(super) center: Vec3<T>,
+    pub(super) occluder: T,
+    pub(super) radius: T,
 }
 
 impl<T: Real> Concentric<T> {
@@ -152,6 +152,26 @@ fn edge_circle<T: Real>(center: Vec3<T>, radius: T, points: [Vec3<T>; 4]) -> Opt
     Some(Some((e, cos, sin)))
 }
 
+/// The corners of `surface` over `r` in order around it, and per edge (s = s₀, s = s₁,
+/// t = t₀, t = t₁) its start, quarter, middle and end points ([`edge_circle`]'s samples).
+fn corners_and_edges<T: Real, S: Surface<T> + ?Sized>(
+    surface: &S,
+    r: ParamRect<T>,
+) -> ([Vec3<T>; 4], [[Vec3<T>; 4]; 4]) {
+    let p = |t: T, s: T| surface.point(t, s);
+    let corners = [p(r.t0, r.s0), p(r.t1, r.s0), p(r.t1, r.s1), p(r.t0, r.s1)];
+    let (tm, sm) = ((r.t0 + r.t1) * T::HALF, (r.s0 + r.s1) * T::HALF);
+    let quarter = |a: T, b: T| a + (b - a) * T::HALF * T::HALF;
+    let (tq, sq) = (quarter(r.t0, r.t1), quarter(r.s0, r.s1));
+    let edges = [
+        [p(r.t0, r.s0), p(tq, r.s0), p(tm, r.s0), p(r.t1, r.s0)],
+        [p(r.t0, r.s1), p(tq, r.s1), p(tm, r.s1), p(r.t1, r.s1)],
+        [p(r.t0, r.s0), p(r.t0, sq), p(r.t0, sm), p(r.t0, r.s1)],
+        [p(r.t1, r.s0), p(r.t1, sq), p(r.t1, sm), p(r.t1, r.s1)],
+    ];
+    (corners, edges)
+}
+
 /// The outer events of the sphere cell `outer` against the sphere cell `inner` over `r` with
 /// the same centre, across the concentric `occluder` or none (module docs); `None` where
 /// either surface does not lie on a sphere, the spheres do not share the centre, the occluder
@@ -184,16 +204,7 @@ where
         events.push(curve, grade)
     };
     let rb = inner_ball.radius;
-    let corners = [(r.t0, r.s0), (r.t1, r.s0), (r.t1, r.s1), (r.t0, r.s1)].map(|(t, s)| inner.point(t, s));
-    let (tm, sm) = ((r.t0 + r.t1) * T::HALF, (r.s0 + r.s1) * T::HALF);
-    let quarter = |a: T, b: T| a + (b - a) * T::HALF * T::HALF;
-    let (tq, sq) = (quarter(r.t0, r.t1), quarter(r.s0, r.s1));
-    let edges = [
-        [inner.point(r.t0, r.s0), inner.point(tq, r.s0), inner.point(tm, r.s0), inner.point(r.t1, r.s0)],
-        [inner.point(r.t0, r.s1), inner.point(tq, r.s1), inner.point(tm, r.s1), inner.point(r.t1, r.s1)],
-        [inner.point(r.t0, r.s0), inner.point(r.t0, sq), inner.point(r.t0, sm), inner.point(r.t0, r.s1)],
-        [inner.point(r.t1, r.s0), inner.point(r.t1, sq), inner.point(r.t1, sm), inner.point(r.t1, r.s1)],
-    ];
+    let (corners, edges) = corners_and_edges(inner, r);
     let mut circles = [None; 4];
     for (slot, edge) in circles.iter_mut().zip(edges) {
         *slot = edge_circle(c, rb, edge)?;
@@ -298,6 +309,114 @@ where
     let k = normal.dot(q0 - c) / big;
     if k.abs() < T::ONE {
         section(normal, k)?;
+    }
+    Some(events)
+}
+
+/// Most curves of an off-centre pair ([`offcentre_events`]): four corners and two per edge.
+const MAX_OFFCENTRE_CURVES: usize = 12;
+
+/// The outer events of a sphere's cell around a concentric pair's inner cell from off the
+/// centre ([`TrigonometricEvents`] with room for twelve quadric sections).
+pub(super) type OffCentreEvents<T> = TrigonometricEvents<
+    T,
+    1,
+    { 20 * MAX_OFFCENTRE_CURVES + 2 },
+    { 4 * MAX_OFFCENTRE_CURVES + 2 },
+    MAX_OFFCENTRE_CURVES,
+>;
+
+/// The outer events of a cell (`a`) of a sphere whose centre C is not the concentric pair's
+/// centre c, against the cell `inner` over `r` of the concentric sphere b's inside (radius
+/// R), across the occluder of radius ρ with centre c (module docs): where b lies in front of
+/// every tangent plane of a's cell and the cell lies inside b's sphere and outside the
+/// occluder, p sees the cap of b about p̂ of angle ψ(d) = acos(ρ/d) + acos(ρ/R), d = |p − c|,
+/// whose outline passes a corner q̂ where p̂·q̂ = cos ψ and touches an edge (the circle
+/// x̂·e = cos α) where p̂·e = cos(ψ ± α). With γ = acos(ρ/R) ∓ α (α = 0 for a corner) and
+/// S = √(d² − ρ²), d·cos(ψ ± α) = ρ·cos γ − S·sin γ, so each is (e·(p − c) − ρ·cos γ)² =
+/// sin²γ·(|p − c|² − ρ²) on the branch where the left factor is negative; on a's sphere
+/// |p − c|² is affine in p, and the curve is L₁² = L₂ with plane tests
+/// ([`TrigonometricEvents::push_quadratic`]; the other branch costs breaks, not accuracy).
+/// `None` where a condition fails, the centres coincide (then [`concentric_events`]), or an
+/// edge of b is not a circle of its sphere.
+pub(super) fn offcentre_events<T, SA, SB>(
+    a: &Patch<'_, T, SA>,
+    inner: &SB,
+    r: ParamRect<T>,
+    occluder: &Concentric<T>,
+) -> Option<OffCentreEvents<T>>
+where
+    T: Real,
+    SA: Surface<T> + ?Sized,
+    SB: Surface<T> + ?Sized,
+{
+    let outer = a.surface();
+    let (sphere, inner_ball) = (outer.on_sphere()?, inner.on_sphere()?);
+    let (big_c, ra) = (sphere.center, sphere.radius);
+    let (c, rb, rho) = (occluder.center, occluder.radius, occluder.occluder);
+    if same_centre(&sphere, &inner_ball) {
+        return None;
+    }
+    let margin = T::GEOMETRY_TOLERANCE * (ra + rb + (big_c - c).norm());
+    let cell = a.rect();
+    let (tm, sm) = ((cell.t0 + cell.t1) * T::HALF, (cell.s0 + cell.s1) * T::HALF);
+    // The side a's cell faces (+1 out of its sphere), and b's inside: its normal towards c.
+    let side = outer.normal(tm, sm).dot(outer.point(tm, sm) - big_c);
+    let (tb, sb) = ((r.t0 + r.t1) * T::HALF, (r.s0 + r.s1) * T::HALF);
+    if !(inner.normal(tb, sb).dot(inner.point(tb, sb) - c) < T::ZERO) || side == T::ZERO {
+        return None;
+    }
+    let sign = if side > T::ZERO { T::ONE } else { -T::ONE };
+    // |p − c|² − k₀ = g·(p − x₀) on a's sphere: |p − c|² = Rₐ² + |w|² + 2w·(p − C), w = C − c.
+    let w = big_c - c;
+    let w2 = w.dot(w);
+    let distance_form = |k0: T, scale: T| -> Option<[[T; 3]; 3]> {
+        let k = (ra * ra + w2 - k0) / (T::TWO * w2);
+        let [form, _] = outer.facing_across_s(big_c - w.scale(k), w.scale(T::TWO * scale))?;
+        Some(form)
+    };
+    let least = |form: [[T; 3]; 3]| trigonometric_least(form, cell);
+    let negative = |form: [[T; 3]; 3]| form.map(|k| k.map(|x| -x));
+    // Outside the occluder and inside b's sphere: ρ² < |p − c|² < R².
+    if !(least(distance_form(rho * rho, T::ONE)?) > margin * rho)
+        || !(least(negative(distance_form(rb * rb, T::ONE)?)) > margin * rb)
+    {
+        return None;
+    }
+    // b in front of every tangent plane of a's cell, by b's enclosing ball (centre m, radius
+    // ρ_b): sign·((m − C)·(p − C) − Rₐ²) > Rₐ·ρ_b.
+    let ball = Patch::new(inner, r).ok()?.enclosing_ball();
+    let v = ball.center - big_c;
+    let v2 = v.dot(v);
+    if !(v2 > T::ZERO) {
+        return None;
+    }
+    let [facing, _] = outer.facing_across_s(big_c + v.scale(ra * ra / v2), v.scale(sign))?;
+    if !(least(facing) > ra * ball.radius + margin * ra) {
+        return None;
+    }
+    let (corners, edges) = corners_and_edges(inner, r);
+    let gamma = (rho / rb).max(-T::ONE).min(T::ONE);
+    let (cos_g, sin_g) = (gamma, (T::ONE - gamma * gamma).max(T::ZERO).sqrt());
+    let mut events = OffCentreEvents::empty();
+    // (e·(p − c) − ρ·cos γ')² = sin²γ'·(|p − c|² − ρ²), for a unit e.
+    let mut push = |e: Vec3<T>, cos: T, sin: T| -> Option<()> {
+        let [l1, _] = outer.facing_across_s(c + e.scale(rho * cos), e)?;
+        events.push_quadratic(l1, distance_form(rho * rho, sin * sin)?)
+    };
+    for q in corners {
+        let v = q - c;
+        let n = v.norm();
+        if !(n > T::ZERO) {
+            return None;
+        }
+        push(v.scale(T::ONE / n), cos_g, sin_g)?;
+    }
+    for edge in edges {
+        let Some((e, cos_a, sin_a)) = edge_circle(c, rb, edge)? else { continue };
+        // γ ∓ α for the outline touching from outside and inside the circle.
+        push(e, cos_g * cos_a + sin_g * sin_a, sin_g * cos_a - cos_g * sin_a)?;
+        push(e, cos_g * cos_a - sin_g * sin_a, sin_g * cos_a + cos_g * sin_a)?;
     }
     Some(events)
 }

@@ -64,7 +64,9 @@
 //! it tangent to the occluder, which meets a's sphere in a curve L₁² = L₂ with L₁, L₂ plane
 //! tests: a second-degree trigonometric polynomial along each meridian, its crossings and
 //! tangencies found by a quartic (`sphere_flat.rs`; orders 12 and 20 within 1e-11,
-//! `general_geometry::sphere_cells_against_parallelograms_across_a_sphere_anywhere`). Elsewhere the outer rule samples across
+//! `general_geometry::sphere_cells_against_parallelograms_across_a_sphere_anywhere`). A cell of a
+//! sphere with another centre around such a concentric pair's inner cell has curves of the
+//! same kind only (`concentric::offcentre_events`). Elsewhere the outer rule samples across
 //! them (algebraic convergence), which patch grids (and the outer split in [`crate::pair`])
 //! reduce.
 //!
@@ -386,8 +388,17 @@ where
     } else {
         None
     };
-    let Some(events) = events else { return Ok(None) };
     let mut f = |t: T, s: T| outer_integrand(surface, t, s, inner, inner_samples, inner_bounds);
+    let Some(events) = events else {
+        // From a sphere with another centre: quadric sections only.
+        let Some(occluder) = inner.concentric.as_ref() else { return Ok(None) };
+        let Some(events) = offcentre_events(a, inner.surface, inner.r, occluder) else { return Ok(None) };
+        let mut total = T::ZERO;
+        for cell in cells {
+            total += events.integrate(*cell, &inner.rule, &mut f)?;
+        }
+        return Ok(Some(total));
+    };
     let mut total = T::ZERO;
     for cell in cells {
         total += events.integrate(*cell, &inner.rule, &mut f)?;
@@ -616,7 +627,9 @@ where
                     true => Some(Concentric::of(surface, &bounds, &outer.enclosing_ball(), occluders)?),
                     false => None,
                 };
-                concentric_events(outer.surface(), surface, r, concentric.as_ref()).map(|_| true)
+                concentric_events(outer.surface(), surface, r, concentric.as_ref())
+                    .map(|_| true)
+                    .or_else(|| offcentre_events(outer, surface, r, concentric.as_ref()?).map(|_| true))
             })
             .or_else(|| shell_flat_of(outer, inner, affine, use_occluders, occluders, &bounds).map(|_| true)),
     }

@@ -169,9 +169,11 @@ fn trig_size<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>) -> T {
 ///   bisected rather than solved); a curved outer patch across a sphere, which gets no outer
 ///   events, converges slowly and not monotonically (cells of two spheres with a third
 ///   between: 9e-4 / 1e-3 / 2e-4 / 1e-4 at orders 8 / 12 / 16 / 20) — except a sphere's cell
-///   around a parallelogram inside it across a sphere with its centre, and a sphere's cell
-///   against a parallelogram in front of all its tangent planes across any one sphere, whose
-///   events are placed (`boundary/concentric.rs`, `boundary/sphere_flat.rs`). Two parallelograms across one sphere have those curves placed
+///   around a parallelogram inside it across a sphere with its centre, a sphere's cell
+///   against a parallelogram in front of all its tangent planes across any one sphere, and a
+///   cell of a sphere inside a shell against a cell of the shell's inside in front of it,
+///   across a sphere with the shell's centre, whose events are placed
+///   (`boundary/concentric.rs`, `boundary/sphere_flat.rs`). Two parallelograms across one sphere have those curves placed
 ///   into the outer rule and converge exponentially (whole cube faces around a sphere: 1.3e-8
 ///   at order 8, 1.6e-11 at 12); an occluder that cuts through the outer patch itself makes the
 ///   outer integrand jump along the cut, and the outer rule converges only like 1/order (a
