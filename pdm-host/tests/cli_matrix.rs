@@ -80,6 +80,22 @@ fn bad_input_is_one_line_and_exit_code_2() {
     let out = pdm(&["matrix", &example("cube.toml"), "--output", dir.path().join("m.xlsx").to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2));
     assert!(!dir.path().join("m.xlsx").exists());
+    // An output folder that does not exist is refused before any work, naming the path.
+    let missing = dir.path().join("no such folder").join("m.json");
+    let out = pdm(&["matrix", &example("sphere_in_cube.toml"), "--output", missing.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("no such folder") && stderr.contains("cannot write there"), "{stderr}");
+    assert!(!String::from_utf8_lossy(&out.stdout).contains("row sum"), "it ran first");
+    // A zero edge is named as such, not as the other edge.
+    std::fs::write(
+        &bad,
+        "[[surface]]\nname = \"a\"\nkind = \"rectangle\"\norigin = [0, 0, 0]\nedge_t = [0, 0, 0]\nedge_s = [0, 1, 0]\n",
+    )
+    .unwrap();
+    let out = pdm(&["matrix", bad.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("field `edge_t`") && stderr.contains("is zero"), "{stderr}");
 }
 
 /// Three slices computed separately and merged give the matrix of the whole run, value for

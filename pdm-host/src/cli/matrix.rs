@@ -177,6 +177,10 @@ pub fn run(args: &MatrixArgs) -> ExitCode {
             eprintln!("error: --output {}: a slice (--shard) is written as .json", out.display());
             return ExitCode::from(EXIT_USAGE);
         }
+        if let Err(e) = report::check_writable(out) {
+            eprintln!("error: --output {}: cannot write there: {e}", out.display());
+            return ExitCode::from(EXIT_USAGE);
+        }
     }
     let method = match args.order {
         Some(order) => PairMethod::Order { order, singular_order: args.singular_order },

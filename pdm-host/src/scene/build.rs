@@ -216,9 +216,17 @@ fn geometry(i: usize, spec: &SurfaceSpec, flip: bool, place: &Place, base: &Path
             let origin = place.point(vector(i, spec, "origin", spec.origin)?);
             let edge_t = place.vector(vector(i, spec, "edge_t", spec.edge_t)?);
             let edge_s = place.vector(vector(i, spec, "edge_s", spec.edge_s)?);
+            for (name, edge) in [("edge_t", edge_t), ("edge_s", edge_s)] {
+                if !(edge.norm() > 0.0) {
+                    return fail(i, spec, name, "is zero (or too small to square): zero area");
+                }
+            }
             let area = edge_t.cross(edge_s).norm();
+            if !(area.is_finite()) {
+                return fail(i, spec, "edge_s", "with edge_t spans an area too large to represent");
+            }
             if !(area > 1e-12 * edge_t.norm() * edge_s.norm()) {
-                return fail(i, spec, "edge_s", "is parallel to edge_t (or one of them is zero): zero area");
+                return fail(i, spec, "edge_s", "is parallel to edge_t: zero area");
             }
             let (edge_t, edge_s) = if flip { (edge_s, edge_t) } else { (edge_t, edge_s) };
             full(Geom::Parallelogram { origin, edge_t, edge_s })

@@ -428,15 +428,25 @@ fn npz(report: &SceneReport) -> Result<Vec<u8>, String> {
 /// Writes `bytes` to `path` atomically: a temporary file in the same folder, renamed into place
 /// (an interrupted or failed run leaves no half-written file).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    let mut tmp = tempfile::NamedTempFile::new_in(dir)?;
+    let mut tmp = tempfile::NamedTempFile::new_in(directory_of(path))?;
     tmp.write_all(bytes)?;
     tmp.as_file().sync_all()?;
     tmp.persist(path).map_err(|e| e.error)?;
     Ok(())
+}
+
+/// The directory a file `path` is written into (`.` for a bare name).
+fn directory_of(path: &Path) -> &Path {
+    match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    }
+}
+
+/// Whether [`write_atomic`] can write `path`: a temporary file can be made in its directory
+/// (checked before a long run, so that a mistyped directory fails at once, not after it).
+pub fn check_writable(path: &Path) -> std::io::Result<()> {
+    tempfile::NamedTempFile::new_in(directory_of(path)).map(drop)
 }
 
 /// The output's bytes by the file's extension: `.csv` long-form CSV, `.json` the whole report,
