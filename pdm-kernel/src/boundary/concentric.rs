@@ -283,34 +283,53 @@ where
         let cos_psi = x * y - (T::ONE - x * x).max(T::ZERO).sqrt() * sin_y;
         section(v.scale(T::ONE / d), cos_psi)?;
     }
-    for (i, q) in corners.iter().enumerate() {
-        let next = *corners.get((i + 1) % 4)?;
-        let edge = next - *q;
-        let length = edge.norm();
-        if !(length > margin) {
-            continue;
-        }
-        let e = edge.scale(T::ONE / length);
-        let foot = *q + e.scale((c - *q).dot(e));
-        let to_foot = foot - c;
-        let d = to_foot.norm();
-        if !(d > rho) {
-            // The edge's line passes through the occluder: every plane through it cuts the
-            // occluder, so the outline crosses the line and never touches it.
-            continue;
-        }
-        let v = to_foot.scale(T::ONE / d);
-        let w = e.cross(v);
-        let (along, across) = (rho / d, (T::ONE - (rho / d) * (rho / d)).max(T::ZERO).sqrt());
-        for sign in [T::ONE, -T::ONE] {
-            section(v.scale(along) + w.scale(sign * across), y)?;
-        }
+    for (_, n) in edge_tangent_planes(&corners, c, rho, margin, T::ZERO).into_iter().flatten() {
+        section(n, y)?;
     }
     let k = normal.dot(q0 - c) / big;
     if k.abs() < T::ONE {
         section(normal, k)?;
     }
     Some(events)
+}
+
+/// The planes through the lines of a quadrilateral's edges (`corners` in order) tangent to
+/// the ball (centre `c`, radius `rho`), two per edge, as (foot of the line's perpendicular from
+/// c, unit normal): with d the line's distance from c, v the unit vector from c to the foot
+/// and e the line's direction, the normals are (ρ/d)·v ± √(1 − ρ²/d²)·e × v. `None` for an
+/// edge shorter than `margin` and for a line within `clearance` of the ball (every plane
+/// through a line that passes through the ball cuts it: the outline crosses the line and
+/// never touches it).
+pub(super) fn edge_tangent_planes<T: Real>(
+    corners: &[Vec3<T>; 4],
+    c: Vec3<T>,
+    rho: T,
+    margin: T,
+    clearance: T,
+) -> [Option<(Vec3<T>, Vec3<T>)>; 8] {
+    let mut planes = [None; 8];
+    for (i, (&q, slots)) in corners.iter().zip(planes.chunks_mut(2)).enumerate() {
+        let Some(&next) = corners.get((i + 1) % 4) else { continue };
+        let edge = next - q;
+        let length = edge.norm();
+        if !(length > margin) {
+            continue;
+        }
+        let e = edge.scale(T::ONE / length);
+        let foot = q + e.scale((c - q).dot(e));
+        let to_foot = foot - c;
+        let d = to_foot.norm();
+        if !(d - rho > clearance) {
+            continue;
+        }
+        let v = to_foot.scale(T::ONE / d);
+        let w = e.cross(v);
+        let (along, across) = (rho / d, (T::ONE - (rho / d) * (rho / d)).max(T::ZERO).sqrt());
+        for (slot, sign) in slots.iter_mut().zip([T::ONE, -T::ONE]) {
+            *slot = Some((foot, v.scale(along) + w.scale(sign * across)));
+        }
+    }
+    planes
 }
 
 /// Most curves of an off-centre pair ([`offcentre_events`]): four corners and two per edge.

@@ -112,28 +112,8 @@ where
         let l2 = section(big_c + w.scale(k), w.scale(-T::TWO * cos2))?;
         events.push_quadratic(section(q, u)?, l2)?;
     }
-    for (i, &q) in corners.iter().enumerate() {
-        let next = *corners.get((i + 1) % 4)?;
-        let edge = next - q;
-        let length = edge.norm();
-        if !(length > margin) {
-            continue;
-        }
-        let e = edge.scale(T::ONE / length);
-        let foot = q + e.scale((c - q).dot(e));
-        let to_foot = foot - c;
-        let d = to_foot.norm();
-        if !(d - rho > margin) {
-            // The edge's line passes through the occluder: every plane through it cuts the
-            // occluder, and the outline crosses the line without touching it.
-            continue;
-        }
-        let v = to_foot.scale(T::ONE / d);
-        let w = e.cross(v);
-        let (along, across) = (rho / d, (T::ONE - (rho / d) * (rho / d)).max(T::ZERO).sqrt());
-        for sign in [T::ONE, -T::ONE] {
-            events.push(section(foot, v.scale(along) + w.scale(sign * across))?, true)?;
-        }
+    for (foot, n) in edge_tangent_planes(&corners, c, rho, margin, margin).into_iter().flatten() {
+        events.push(section(foot, n)?, true)?;
     }
     Some(events)
 }
