@@ -96,6 +96,61 @@ fn bad_input_is_one_line_and_exit_code_2() {
     let out = pdm(&["matrix", bad.to_str().unwrap()]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.contains("field `edge_t`") && stderr.contains("is zero"), "{stderr}");
+    // A value of the wrong type names its field; a length whose square underflows too.
+    for (text, field) in [
+        (
+            "kind = \"rectangle\"\norigin = [0, 0, 0]\nedge_t = [1, 0, 0]\nedge_s = [0, 1, 0]\nsubdivide = [-2, 2]\n",
+            "field `subdivide`",
+        ),
+        ("kind = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1e-300\n", "field `radius` 1e-300 is out of range"),
+    ] {
+        std::fs::write(&bad, format!("[[surface]]\nname = \"a\"\n{text}")).unwrap();
+        let out = pdm(&["matrix", bad.to_str().unwrap()]);
+        assert_eq!(out.status.code(), Some(2), "{text}");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
+        assert!(stderr.contains(field), "{stderr}");
+    }
+}
+
+/// A reader that closes the pipe early (`pdm-ff matrix … | head -2`) ends the run quietly with
+/// the code a shell gives a process SIGPIPE ended (141), not a panic; the `--output` file is
+/// still written.
+#[test]
+fn a_closed_pipe_ends_quietly_and_the_output_is_written() {
+    use std::io::Read as _;
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("m.json");
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_pdm-ff"))
+        .args(["matrix", &example("cube.toml"), "--output", json.to_str().unwrap()])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Close stdout at once, before anything is printed.
+    drop(child.stdout.take());
+    let mut stderr = String::new();
+    child.stderr.take().unwrap().read_to_string(&mut stderr).unwrap();
+    let status = child.wait().unwrap();
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert!(status.success() || status.code() == Some(141), "{status:?}: {stderr}");
+    assert!(json.exists(), "{stderr}");
+    // Elsewhere a write to the closed stdout ends the run (exit code 141), without a panic: a
+    // slice's summary line, after its file is written.
+    let slice = dir.path().join("s.json");
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_pdm-ff"))
+        .args(["matrix", &example("cube.toml"), "--shard", "1/2", "--output", slice.to_str().unwrap()])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let mut stderr = String::new();
+    child.stderr.take().unwrap().read_to_string(&mut stderr).unwrap();
+    let status = child.wait().unwrap();
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_eq!(status.code(), Some(141), "{stderr}");
+    assert!(slice.exists());
 }
 
 /// Three slices computed separately and merged give the matrix of the whole run, value for

@@ -79,6 +79,54 @@ fn placement_does_not_change_the_factors() {
     }
 }
 
+/// A 1 cm cube 7 m from the origin in f32 (scene red-team): the corners computed at that
+/// magnitude were 3e-5 of a patch's side off, 56 of 480 patch entries lay beyond their
+/// estimates (up to 1.9×) and rows 4.6e-5 above 1 with a false overlap warning. In f32 the
+/// scene is computed centred on the origin (`Scene::centred`): every patch entry against the
+/// unit cube's f64 entries (the same factors, scale-free; the f64 values within 1e-12 of
+/// C-11/C-14 by `unit_cube_against_c11_and_c14`) within its estimate, and the rows within
+/// 1e-6 of 1.
+#[test]
+fn f32_cube_far_from_the_origin_is_computed_centred() {
+    let unit = run(&scene(CUBE), PairMethod::tolerance(1e-9));
+    // Every origin and edge scaled to 1 cm, then each face moved by one translation.
+    let far: String = CUBE
+        .lines()
+        .map(|line| match line.split_once(" = [") {
+            Some((key, rest)) if ["origin", "edge_t", "edge_s"].contains(&key) => {
+                let numbers = rest.split(']').next().unwrap();
+                let scaled: Vec<String> =
+                    numbers.split(',').map(|x| format!("{}", x.trim().parse::<f64>().unwrap() * 0.01)).collect();
+                format!("{key} = [{}]\n", scaled.join(", "))
+            }
+            _ if line.starts_with("subdivide") => format!("{line}\ntranslate = [5.003, 4.997, -3.001]\n"),
+            _ => format!("{line}\n"),
+        })
+        .collect();
+    let s = scene(&far);
+    let result = compute::<f32>(&s, PairMethod::tolerance(1e-4), None, 0, &|_| {}).unwrap_or_else(|e| panic!("{e:?}"));
+    let r = assemble(&s, &result, PairMethod::tolerance(1e-4));
+    let errors = r.patches.errors.as_ref().expect("tolerance mode");
+    let mut worst: f64 = 0.0;
+    for (i, row) in r.patches.factors.iter().enumerate() {
+        for (j, &f) in row.iter().enumerate() {
+            let actual = (f - unit.patches.factors[i][j]).abs();
+            assert!(
+                actual <= errors[i][j],
+                "[{i}][{j}]: {f} against {}, estimate {:e}",
+                unit.patches.factors[i][j],
+                errors[i][j]
+            );
+            worst = worst.max(actual);
+        }
+    }
+    for (i, sum) in r.surfaces.row_sums.iter().enumerate() {
+        assert!((sum - 1.0).abs() < 1e-6, "row {i}: {sum}");
+    }
+    assert!(r.diagnostics.enclosure_gaps.is_empty(), "{:?}", r.diagnostics.enclosure_gaps);
+    println!("largest patch entry error {worst:e}");
+}
+
 #[test]
 fn closed_cylinder_against_c41_and_the_sum_rule() {
     let s = scene(include_str!("../../examples/scenes/closed_cylinder.toml"));

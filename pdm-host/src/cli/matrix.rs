@@ -140,7 +140,8 @@ pub fn run_merge(args: &MergeArgs) -> ExitCode {
         }
     };
     let report = report::assemble(&scene, &merged, first.method);
-    print!("{}", report::text(&report));
+    // A closed stdout (`| head`) must not stop the output file from being written.
+    let _ = std::io::Write::write_all(&mut std::io::stdout(), report::text(&report).as_bytes());
     match &args.output {
         Some(out) => write_report(&report, out),
         None => ExitCode::SUCCESS,
@@ -258,7 +259,8 @@ pub fn run(args: &MatrixArgs) -> ExitCode {
         return ExitCode::SUCCESS;
     }
     let report = report::assemble(&scene, &result, method);
-    print!("{}", report::text(&report));
+    // A closed stdout (`| head`) must not stop the output file from being written.
+    let _ = std::io::Write::write_all(&mut std::io::stdout(), report::text(&report).as_bytes());
     match &args.output {
         Some(out) => write_report(&report, out),
         None => ExitCode::SUCCESS,

@@ -183,6 +183,7 @@ fn parse_radius(s: &str) -> Result<f64, String> {
 
 /// Parses the command line and runs it; the process exit code.
 pub fn main() -> ExitCode {
+    quiet_on_a_closed_pipe();
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => return clap_error(&e),
@@ -200,6 +201,31 @@ pub fn main() -> ExitCode {
         },
     }
 }
+
+/// A reader that stops early (`pdm-ff matrix scene.toml | head -4`) closes the pipe, and
+/// Rust's `println!`/`eprintln!` panic on the next write. Such a panic ends the program as a
+/// process killed by SIGPIPE would (exit code 141, no message: the reader is gone); every
+/// other panic goes to the default hook. (The scene tables are written without panicking,
+/// so that `--output` is still written after a closed stdout.)
+fn quiet_on_a_closed_pipe() {
+    let default = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let payload = info.payload();
+        let message = payload
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| payload.downcast_ref::<&str>().copied())
+            .unwrap_or("");
+        if message.starts_with("failed printing to std") && message.contains("Broken pipe") {
+            std::process::exit(EXIT_CLOSED_PIPE);
+        }
+        default(info);
+    }));
+}
+
+/// Exit code after a closed output pipe: 128 + SIGPIPE, as a shell reports a process the
+/// signal ended.
+const EXIT_CLOSED_PIPE: i32 = 141;
 
 /// Help and version go to stdout with success; errors become one line on stderr.
 fn clap_error(e: &clap::Error) -> ExitCode {

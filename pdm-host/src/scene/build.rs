@@ -160,6 +160,13 @@ fn positive(i: usize, spec: &SurfaceSpec, name: &str, value: Option<f64>) -> Res
     match value {
         None => fail(i, spec, name, format!("missing (kind {} needs it)", spec.kind.name())),
         Some(x) if !(x.is_finite() && x > 0.0) => fail(i, spec, name, format!("{x} must be positive and finite")),
+        // A length whose square (an area) is 0 or infinite in f64.
+        Some(x) if !(x * x > 0.0 && (x * x).is_finite()) => fail(
+            i,
+            spec,
+            name,
+            format!("{x:e} is out of range: its square, an area, is not a finite non-zero f64 (use other units)"),
+        ),
         Some(x) => Ok(x),
     }
 }
@@ -591,4 +598,37 @@ pub fn build_in(file: &SceneFile, base: &Path) -> Result<Scene, EntryError> {
         });
     }
     Ok(Scene { units: file.units.clone(), enclosure: file.enclosure, surfaces, obstructions, patches })
+}
+
+impl Scene {
+    /// The same scene moved so that its bounding box is centred on the origin. Form factors do
+    /// not depend on where a scene lies, but the kernel computes every point at the magnitude
+    /// of its coordinates: in f32 a 1 cm patch 10 m from the origin has its corners 1e-4 of
+    /// its size off. `pdm-ff matrix` computes on the centred copy in f32, where the move (in
+    /// f64) costs nothing against f32's resolution; not in f64, where the move itself would
+    /// round at the old magnitude, by as much as the kernel does, and part surfaces that
+    /// shared an edge to the last bit. Centred, the coordinates are at most half the scene's
+    /// extent; a small part far from the rest still carries that extent, and the kernel's
+    /// estimates allow for it (`adaptive_exchange`).
+    #[must_use]
+    pub fn centred(&self) -> Self {
+        let origin = vec3(0.0, 0.0, 0.0);
+        let (mut lo, mut hi) = ([f64::MAX; 3], [-f64::MAX; 3]);
+        for piece in self.surfaces.iter().chain(&self.obstructions).flat_map(|s| &s.pieces) {
+            for (k, normal) in [vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0), vec3(0.0, 0.0, 1.0)].into_iter().enumerate() {
+                let (a, b) = piece.geom.distance_range(piece.rect, &super::shape::Plane { origin, normal });
+                lo[k] = lo[k].min(a);
+                hi[k] = hi[k].max(b);
+            }
+        }
+        let centre = vec3((lo[0] + hi[0]) * 0.5, (lo[1] + hi[1]) * 0.5, (lo[2] + hi[2]) * 0.5);
+        let mut moved = self.clone();
+        if centre.x.is_finite() && centre.y.is_finite() && centre.z.is_finite() {
+            let shift = vec3(-centre.x, -centre.y, -centre.z);
+            for piece in moved.surfaces.iter_mut().chain(moved.obstructions.iter_mut()).flat_map(|s| &mut s.pieces) {
+                piece.geom = piece.geom.translated(shift);
+            }
+        }
+        moved
+    }
 }

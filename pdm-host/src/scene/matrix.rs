@@ -447,6 +447,14 @@ pub fn compute<T: Real>(
             compute_with::<T, CAP>(self.scene, self.method, self.shard, self.threads, self.progress)
         }
     }
+    // Below f64, on the scene centred on the origin (`Scene::centred`).
+    let centred;
+    let scene = if T::EPSILON.to_f64() > f64::EPSILON {
+        centred = scene.centred();
+        &centred
+    } else {
+        scene
+    };
     let job = Job::<T> { scene, method, shard, threads, progress, precision: std::marker::PhantomData };
     pdm_kernel::with_capacity(method.capacity(), job).map_err(|error| MatrixError::Threads(error.to_string()))?
 }

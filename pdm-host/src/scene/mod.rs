@@ -129,10 +129,19 @@ pub fn vs3_notes(path: &Path) -> Vec<String> {
 pub fn parse(text: &str, format: Format, file: &str) -> Result<SceneFile, SceneError> {
     match format {
         Format::Vs3 => vs3_scene(text, file),
-        Format::Toml => toml::from_str::<SceneFile>(text).map_err(|e| SceneError {
-            file: file.to_string(),
-            line: e.span().map(|s| line_of(text, s.start)),
-            message: one_line(e.message()),
+        Format::Toml => toml::from_str::<SceneFile>(text).map_err(|e| {
+            // A bad value names the key it belongs to where its line has one (`subdivide =
+            // [-2, 2]`: "field `subdivide`: invalid value: integer `-2`, expected usize").
+            let key = e.span().and_then(|s| key_before(text, s.start));
+            let message = one_line(e.message());
+            SceneError {
+                file: file.to_string(),
+                line: e.span().map(|s| line_of(text, s.start)),
+                message: match key {
+                    Some(key) if !message.contains(&format!("`{key}`")) => format!("field `{key}`: {message}"),
+                    _ => message,
+                },
+            }
         }),
         Format::Json => serde_json::from_str::<SceneFile>(text).map_err(|e| {
             let message = one_line(&e.to_string());
@@ -141,6 +150,16 @@ pub fn parse(text: &str, format: Format, file: &str) -> Result<SceneFile, SceneE
             SceneError { file: file.to_string(), line: (e.line() > 0).then_some(e.line()), message }
         }),
     }
+}
+
+/// The key of the `key = value` on the line of byte `at`, if `at` lies in its value.
+fn key_before(text: &str, at: usize) -> Option<&str> {
+    let at = at.min(text.len());
+    let start = text.get(..at)?.rfind('\n').map_or(0, |k| k + 1);
+    let (key, _) = text.get(start..at)?.split_once('=')?;
+    let key = key.trim();
+    let bare = !key.is_empty() && key.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-' || c == '.');
+    bare.then_some(key)
 }
 
 /// Parses and builds a scene text.

@@ -230,6 +230,28 @@ impl Geom {
         })
     }
 
+    /// The same geometry moved by `shift` (frames, radii and edges unchanged).
+    #[must_use]
+    pub fn translated(&self, shift: Vec3<f64>) -> Self {
+        match *self {
+            Self::Parallelogram { origin, edge_t, edge_s } => {
+                Self::Parallelogram { origin: origin + shift, edge_t, edge_s }
+            }
+            Self::Disk { center, frame, inner, outer } => Self::Disk { center: center + shift, frame, inner, outer },
+            Self::Sphere { center, radius, frame, inner } => {
+                Self::Sphere { center: center + shift, radius, frame, inner }
+            }
+            Self::Cylinder { base, frame, radius, height, inner } => {
+                Self::Cylinder { base: base + shift, frame, radius, height, inner }
+            }
+            Self::Cone { base, frame, base_radius, top_radius, height, inner } => {
+                Self::Cone { base: base + shift, frame, base_radius, top_radius, height, inner }
+            }
+            Self::Bezier { control } => Self::Bezier { control: control.map(|row| row.map(|p| p + shift)) },
+            Self::Quadrilateral { corners } => Self::Quadrilateral { corners: corners.map(|p| p + shift) },
+        }
+    }
+
     /// The parameter domain of the whole kind (the file's ranges select a part of it).
     #[must_use]
     pub fn domain(&self) -> Rect {

@@ -91,7 +91,7 @@ where
 /// farthest, widened by 1/8 as [`Patch::enclosing_ball`] is (the culling tests treat it as a
 /// bound, and the corners' rounding must stay inside).
 #[cfg(feature = "closed-form")]
-fn corner_ball<T: Real>(corners: &[Vec3<T>; 4]) -> crate::vec3::Ball<T> {
+pub(crate) fn corner_ball<T: Real>(corners: &[Vec3<T>; 4]) -> crate::vec3::Ball<T> {
     let [c0, c1, c2, c3] = *corners;
     let center = (c0 + c1 + c2 + c3).scale(T::HALF * T::HALF);
     let radius = corners.iter().fold(T::ZERO, |r, &c| r.max((c - center).norm()));
@@ -110,7 +110,7 @@ pub(super) enum FlatShape<'p, 'r, T: Real, SA: Surface<T> + ?Sized, SB: Surface<
 /// patches with straight edges ([`Surface::straight_corners`]: parallelograms, quadrilaterals,
 /// triangles, whose repeated corner is an edge of length zero that contributes nothing).
 #[cfg(feature = "closed-form")]
-pub(super) fn flat_corners<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>) -> Option<([Vec3<T>; 4], Vec3<T>)> {
+pub(crate) fn flat_corners<T: Real, S: Surface<T> + ?Sized>(p: &Patch<'_, T, S>) -> Option<([Vec3<T>; 4], Vec3<T>)> {
     let r = p.rect();
     let corners = p.surface().straight_corners(r)?;
     let normal = p.surface().normal((r.t0 + r.t1) * T::HALF, (r.s0 + r.s1) * T::HALF);

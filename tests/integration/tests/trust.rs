@@ -1693,3 +1693,64 @@ mod boxes_on_the_floor {
         assert!(rel(value, q6) < 1e-9);
     }
 }
+
+/// f32 pairs far from the origin for their size: every point is computed at the magnitude of
+/// its coordinates, up to ε·|x| off, which at 10⁴ sizes from the origin moves corners and
+/// gaps by 1e-3 of the patches' size. The tolerance mode's estimate must cover that
+/// (`adaptive::position_allowance`); it covered only the arithmetic (128 ε, 1.5e-5 relative)
+/// and lay 5–50× below the error. Catalogue references: C-11 (parallel squares), C-14
+/// (perpendicular squares sharing an edge), C-41 (coaxial disks); 1 cm geometry at 12
+/// placements 3 to 150 m from the origin in six directions.
+#[test]
+fn f32_estimates_cover_the_rounding_of_far_coordinates() {
+    use pdm_kernel::{adaptive_exchange, Adaptive, Parallelogram};
+    let k = 0.01;
+    let c11 = exact::parallel_rectangles(1.0, 1.0, 1.0) * k * k;
+    let c14 = exact::perpendicular_rectangles(1.0, 1.0, 1.0) * k * k;
+    let c41 = exact::coaxial_disks(0.5, 0.4, 0.8) * core::f64::consts::PI * 0.25 * k * k;
+    let directions = [[0.83, 0.52, -0.21], [-0.37, 0.91, 0.18], [0.11, -0.29, 0.95], [-0.7, -0.5, 0.51]];
+    let mut worst: f64 = 0.0;
+    let mut worst_error: f64 = 0.0;
+    for (i, d) in directions.iter().enumerate() {
+        for (j, distance) in [3.1, 27.3, 151.7].into_iter().enumerate() {
+            if (i + j) % 4 == 3 {
+                continue;
+            }
+            let o = [d[0] * distance, d[1] * distance, d[2] * distance];
+            let at = |p: [f64; 3]| v::<f32>([o[0] + p[0] * k, o[1] + p[1] * k, o[2] + p[2] * k]);
+            let edge = |p: [f64; 3]| v::<f32>([p[0] * k, p[1] * k, p[2] * k]);
+            let floor = Parallelogram::new(at([0.0, 0.0, 0.0]), edge([1.0, 0.0, 0.0]), edge([0.0, 1.0, 0.0])).unwrap();
+            let ceiling =
+                Parallelogram::new(at([0.0, 0.0, 1.0]), edge([0.0, 1.0, 0.0]), edge([1.0, 0.0, 0.0])).unwrap();
+            let wall = Parallelogram::new(at([0.0, 0.0, 0.0]), edge([0.0, 0.0, 1.0]), edge([1.0, 0.0, 0.0])).unwrap();
+            let lower = Disk::new(at([0.0, 0.0, 0.0]), vec3(0.0, 0.0, 1.0), (0.5 * k) as f32).unwrap();
+            let upper = Disk::new(at([0.0, 0.0, 0.8]), vec3(0.0, 0.0, -1.0), (0.4 * k) as f32).unwrap();
+            let settings = Adaptive::new(1e-4);
+            let mut check = |name: &str, e: pdm_kernel::Estimate<f32>, reference: f64| {
+                let error = (f64::from(e.value) - reference).abs();
+                let estimate = f64::from(e.error.unwrap());
+                println!(
+                    "{name} at {distance} m: error {:.2e}, estimate {:.2e} (relative)",
+                    error / reference,
+                    estimate / reference
+                );
+                assert!(error <= estimate, "{name} at {o:?}: error {error:e} above the estimate {estimate:e}");
+                assert!(estimate <= 0.05 * reference, "{name} at {o:?}: estimate {estimate:e} of {reference:e}");
+                worst = worst.max(error / estimate);
+                worst_error = worst_error.max(error / reference);
+            };
+            let (pf, pc, pw) =
+                (Patch::whole(&floor).unwrap(), Patch::whole(&ceiling).unwrap(), Patch::whole(&wall).unwrap());
+            let e = adaptive_exchange::<f32, _, _, _, 144>(&pf, &pc, settings, &()).unwrap();
+            check("C-11", e, c11);
+            let e = adaptive_exchange::<f32, _, _, _, 144>(&pf, &pw, settings, &()).unwrap();
+            check("C-14", e, c14);
+            let (pl, pu) = (Patch::whole(&lower).unwrap(), Patch::whole(&upper).unwrap());
+            let e = adaptive_exchange::<f32, _, _, _, 144>(&pl, &pu, settings, &()).unwrap();
+            check("C-41", e, c41);
+        }
+    }
+    println!("largest error / estimate {worst:.3}, largest relative error {worst_error:.2e}");
+    // The placements do reach errors the arithmetic's allowance (1.5e-5) does not cover.
+    assert!(worst_error > 1e-4, "{worst_error:e}");
+}
