@@ -140,12 +140,12 @@ pub fn run_merge(args: &MergeArgs) -> ExitCode {
         }
     };
     let report = report::assemble(&scene, &merged, first.method);
-    // A closed stdout (`| head`) must not stop the output file from being written.
-    let _ = std::io::Write::write_all(&mut std::io::stdout(), report::text(&report).as_bytes());
-    match &args.output {
+    let printed = print_table(&report);
+    let written = match &args.output {
         Some(out) => write_report(&report, out),
         None => ExitCode::SUCCESS,
-    }
+    };
+    printed.unwrap_or(written)
 }
 
 /// The memory the system can still give (Linux: `MemAvailable` of `/proc/meminfo`), in bytes;
@@ -158,6 +158,19 @@ fn available_memory() -> Option<u64> {
 }
 
 /// Runs the command.
+/// Prints the report's tables to stdout. A closed pipe (`| head`) is no error: the reader has
+/// what it wanted, and `--output` is still written; any other failure (a full disk) is, after
+/// `--output` is written: `Some(code)` then.
+fn print_table(report: &report::SceneReport) -> Option<ExitCode> {
+    match std::io::Write::write_all(&mut std::io::stdout(), report::text(report).as_bytes()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+            eprintln!("error: cannot print the tables: {e}");
+            Some(ExitCode::from(EXIT_FAILURE))
+        }
+        _ => None,
+    }
+}
+
 pub fn run(args: &MatrixArgs) -> ExitCode {
     let (model, scene) = match scene::load_model(&args.scene) {
         Ok(s) => s,
@@ -259,10 +272,10 @@ pub fn run(args: &MatrixArgs) -> ExitCode {
         return ExitCode::SUCCESS;
     }
     let report = report::assemble(&scene, &result, method);
-    // A closed stdout (`| head`) must not stop the output file from being written.
-    let _ = std::io::Write::write_all(&mut std::io::stdout(), report::text(&report).as_bytes());
-    match &args.output {
+    let printed = print_table(&report);
+    let written = match &args.output {
         Some(out) => write_report(&report, out),
         None => ExitCode::SUCCESS,
-    }
+    };
+    printed.unwrap_or(written)
 }

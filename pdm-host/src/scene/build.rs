@@ -160,8 +160,8 @@ fn positive(i: usize, spec: &SurfaceSpec, name: &str, value: Option<f64>) -> Res
     match value {
         None => fail(i, spec, name, format!("missing (kind {} needs it)", spec.kind.name())),
         Some(x) if !(x.is_finite() && x > 0.0) => fail(i, spec, name, format!("{x} must be positive and finite")),
-        // A length whose square (an area) is 0 or infinite in f64.
-        Some(x) if !(x * x > 0.0 && (x * x).is_finite()) => fail(
+        // The radius of a sphere or disk, whose square (an area) is 0 or infinite in f64.
+        Some(x) if matches!(spec.kind, Kind::Sphere | Kind::Disk) && !(x * x > 0.0 && (x * x).is_finite()) => fail(
             i,
             spec,
             name,

@@ -152,12 +152,14 @@ pub fn parse(text: &str, format: Format, file: &str) -> Result<SceneFile, SceneE
     }
 }
 
-/// The key of the `key = value` on the line of byte `at`, if `at` lies in its value.
+/// The key of the `key = value` on the line of byte `at` whose value holds `at` (the
+/// innermost, in an inline table: `rotate = { axis = [1, 0, 0], degrees = "x" }` gives
+/// `degrees`).
 fn key_before(text: &str, at: usize) -> Option<&str> {
     let at = at.min(text.len());
     let start = text.get(..at)?.rfind('\n').map_or(0, |k| k + 1);
-    let (key, _) = text.get(start..at)?.split_once('=')?;
-    let key = key.trim();
+    let (before, _) = text.get(start..at)?.rsplit_once('=')?;
+    let key = before.rsplit(['{', ',']).next()?.trim();
     let bare = !key.is_empty() && key.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-' || c == '.');
     bare.then_some(key)
 }

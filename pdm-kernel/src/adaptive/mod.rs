@@ -54,8 +54,8 @@
 //! * Far from the origin for their size, the patches' points are computed at the magnitude of
 //!   their coordinates, up to ε·|x| off: every pair's estimate also carries an allowance for
 //!   that (`position_allowance`: the first-order change of the integrand under such moves,
-//!   exact for two flat patches in front of each other, sampled at order 4 otherwise, times a
-//!   measured factor; zero where the coordinates are below about 5 sides of the patches).
+//!   from the corners for two flat patches in front of each other, sampled at order 4
+//!   otherwise, times a measured factor; zero where the coordinates are below about 5 sides of the patches).
 //!   A 1 cm cell 100 m from the origin in f32 gets an estimate of about 1e-2 of its value.
 //! * With a fast sine and cosine (the `micromath` feature, f32), the sample points of curved
 //!   surfaces lie up to [`Real::ELEMENTARY_ERROR`] (2e-3 of the surface's size) off the
@@ -304,7 +304,7 @@ where
         ([crate::vec3::Vec3<T>; 4], crate::vec3::Vec3<T>),
     )> = None;
     let (reach, relative) = if let Some(((ca, _), (cb, _))) = corners {
-        let reach = ca.iter().chain(cb.iter()).fold(T::ZERO, |m, c| m.max(c.norm2())).sqrt();
+        let reach = ca.iter().chain(cb.iter()).fold(T::ZERO, |m, c| m.max(c.norm()));
         let perimeter = |c: &[crate::vec3::Vec3<T>; 4]| {
             (c[1] - c[0]).norm() + (c[2] - c[1]).norm() + (c[3] - c[2]).norm() + (c[0] - c[3]).norm()
         };
@@ -312,9 +312,11 @@ where
     } else {
         let (ball_a, ball_b) = (a.enclosing_ball(), b.enclosing_ball());
         let reach = (ball_a.center.norm() + ball_a.radius).max(ball_b.center.norm() + ball_b.radius);
-        // A patch's perimeter is at most 8 × its enclosing radius: a cheap test first.
-        let eight = T::from_f64(8.0);
-        if !(reach * eight * (ball_a.radius / area_a + ball_b.radius / area_b) > gate) {
+        // A cheap test first: a patch's perimeter by `side_lengths` stays below 10 × its
+        // enclosing radius (a whole disk of radius R, about the worst: 14.4 R against a ball
+        // of 1.69 R; a whole sphere 18.7 R against 2.25 R).
+        let ten = T::from_f64(10.0);
+        if !(reach * ten * (ball_a.radius / area_a + ball_b.radius / area_b) > gate) {
             return Ok(T::ZERO);
         }
         let perimeter = |(along_t, along_s): (T, T)| T::TWO * (along_t + along_s);
