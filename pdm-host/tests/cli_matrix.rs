@@ -113,41 +113,38 @@ fn bad_input_is_one_line_and_exit_code_2() {
     }
 }
 
+/// Runs `pdm-ff` with its stdout closed at once, before anything is printed: the exit status
+/// and what it wrote to stderr.
+fn with_closed_stdout(args: &[&str]) -> (std::process::ExitStatus, String) {
+    use std::io::Read as _;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_pdm-ff"))
+        .args(args)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let mut stderr = String::new();
+    child.stderr.take().unwrap().read_to_string(&mut stderr).unwrap();
+    (child.wait().unwrap(), stderr)
+}
+
 /// A reader that closes the pipe early (`pdm-ff matrix … | head -2`) ends the run quietly with
 /// the code a shell gives a process SIGPIPE ended (141), not a panic; the `--output` file is
 /// still written.
 #[test]
 fn a_closed_pipe_ends_quietly_and_the_output_is_written() {
-    use std::io::Read as _;
     let dir = tempfile::tempdir().unwrap();
     let json = dir.path().join("m.json");
-    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_pdm-ff"))
-        .args(["matrix", &example("cube.toml"), "--output", json.to_str().unwrap()])
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    // Close stdout at once, before anything is printed.
-    drop(child.stdout.take());
-    let mut stderr = String::new();
-    child.stderr.take().unwrap().read_to_string(&mut stderr).unwrap();
-    let status = child.wait().unwrap();
+    let (status, stderr) = with_closed_stdout(&["matrix", &example("cube.toml"), "--output", json.to_str().unwrap()]);
     assert!(!stderr.contains("panicked"), "{stderr}");
     assert!(status.success() || status.code() == Some(141), "{status:?}: {stderr}");
     assert!(json.exists(), "{stderr}");
     // Elsewhere a write to the closed stdout ends the run (exit code 141), without a panic: a
     // slice's summary line, after its file is written.
     let slice = dir.path().join("s.json");
-    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_pdm-ff"))
-        .args(["matrix", &example("cube.toml"), "--shard", "1/2", "--output", slice.to_str().unwrap()])
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    drop(child.stdout.take());
-    let mut stderr = String::new();
-    child.stderr.take().unwrap().read_to_string(&mut stderr).unwrap();
-    let status = child.wait().unwrap();
+    let (status, stderr) =
+        with_closed_stdout(&["matrix", &example("cube.toml"), "--shard", "1/2", "--output", slice.to_str().unwrap()]);
     assert!(!stderr.contains("panicked"), "{stderr}");
     assert_eq!(status.code(), Some(141), "{stderr}");
     assert!(slice.exists());
