@@ -13,7 +13,7 @@ use rayon::prelude::*;
 use super::build::{Scene, ScenePatch};
 use super::model::Kind;
 use super::part::{Part, SceneOccluder};
-use super::shape::{corners, occluder_of, Geom, Plane, Shape};
+use super::shape::{occluder_of, Geom, Plane, Shape};
 use crate::validate::stack;
 
 /// How each pair is integrated.
@@ -157,30 +157,24 @@ struct PatchInfo<T> {
     area: T,
 }
 
-/// Whether the patch `p` lies within the closed solid bounded by the concave surface `solid`
-/// (a segment between it and a point of that surface then stays inside the solid, which its
-/// surface cannot cut). Conservative: `false` when unsure.
+/// Whether the patch `p` lies within the closed convex solid that the surface `solid` (a
+/// sphere, tube or cone, either side, whole or a part) lies on the boundary of: a segment
+/// between two points of that solid stays inside it, which its surface cannot cut.
+/// Conservative: `false` when unsure, and for every other kind.
 fn inside_solid(solid: &Geom, geom: &Geom, p: &ScenePatch, ball: (Vec3<f64>, f64), tol: f64) -> bool {
     let (bc, br) = ball;
+    // Points and circles whose hull holds the patch (`Geom::cover`); the patch's enclosing
+    // ball is a second bound, tighter for a small cell of a large surface.
+    let cover = geom.cover(p.rect);
     match *solid {
         Geom::Sphere { center, radius, .. } => {
-            let reach = match *geom {
-                Geom::Parallelogram { origin, edge_t, edge_s } => {
-                    corners(origin, edge_t, edge_s, p.rect).map(|x| (x - center).norm()).fold(0.0, f64::max)
-                }
-                Geom::Disk { center: c, outer, .. } => (c - center).norm() + outer,
-                // A part of a sphere lies on it: within the whole sphere's reach, which is
-                // tighter than a part's ball (an octant's ball reaches 1.125 radii from its
-                // centre, 2.1 from the origin for a unit sphere's octant).
-                Geom::Sphere { center: c, radius: r, .. } => ((c - center).norm() + r).min((bc - center).norm() + br),
-                _ => (bc - center).norm() + br,
-            };
-            reach <= radius + tol
+            let reach = cover.iter().map(|&(c, r)| (c - center).norm() + r).fold(0.0, f64::max);
+            reach.min((bc - center).norm() + br) <= radius + tol
         }
         // A tube (r₀ = r₁) or a cone or frustum bounds a convex solid: 0 ≤ z ≤ h along the axis,
-        // distance from the axis ≤ r(z) = r₀ + (r₁ − r₀)·z/h. A parallelogram is inside when
-        // its corners are; any other patch when its farthest reach from the axis stays within
-        // the smaller radius over its axial range (r is linear in z).
+        // distance from the axis ≤ r(z) = r₀ + (r₁ − r₀)·z/h, linear in z. A point of the cover
+        // is checked against the radius at its own z; a circle or ball of radius ρ against the
+        // smaller radius over its axial span (its centre's z ± ρ, within the patch's).
         Geom::Cylinder { base, frame, radius: base_radius, height, .. }
         | Geom::Cone { base, frame, base_radius, height, .. } => {
             let top_radius = match *solid {
@@ -197,12 +191,12 @@ fn inside_solid(solid: &Geom, geom: &Geom, p: &ScenePatch, ball: (Vec3<f64>, f64
                 (d - frame.axis.scale(d.dot(frame.axis))).norm()
             };
             let radius_at = |z: f64| base_radius + (top_radius - base_radius) * (z / height).clamp(0.0, 1.0);
-            match *geom {
-                Geom::Parallelogram { origin, edge_t, edge_s } => corners(origin, edge_t, edge_s, p.rect)
-                    .all(|x| radial(x) <= radius_at((x - base).dot(frame.axis)) + tol),
-                Geom::Disk { center, outer, .. } => radial(center) + outer <= radius_at(lo).min(radius_at(hi)) + tol,
-                _ => radial(bc) + br <= radius_at(lo).min(radius_at(hi)) + tol,
-            }
+            let least_radius = |z0: f64, z1: f64| radius_at(z0.max(lo)).min(radius_at(z1.min(hi)));
+            let by_cover = cover.iter().all(|&(c, r)| {
+                let z = (c - base).dot(frame.axis);
+                radial(c) + r <= least_radius(z - r, z + r) + tol
+            });
+            by_cover || radial(bc) + br <= least_radius(lo, hi) + tol
         }
         _ => false,
     }
@@ -342,6 +336,17 @@ impl<T: Real> Context<'_, T> {
             };
             if !ok {
                 continue;
+            }
+            // A piece of a sphere, tube or cone lies on the boundary of a convex solid; a
+            // segment between two points of that solid stays in it and meets its boundary only
+            // at its ends or along a line of it (a set of measure zero), so the piece cannot
+            // cut a pair that the solid holds (the ends of a closed tube, a ball's contents).
+            if let Some(piece_geom) = scene.any_surface(k).pieces.get(piece).map(|p| &p.geom) {
+                if inside_solid(piece_geom, gi, pi, self.balls[i], self.tol)
+                    && inside_solid(piece_geom, gj, pj, self.balls[j], self.tol)
+                {
+                    continue;
+                }
             }
             let (Some(occluder), Some(plane), Some(polygon)) =
                 (self.occluders[k].get(piece), self.piece_planes[k].get(piece), self.piece_polygons[k].get(piece))

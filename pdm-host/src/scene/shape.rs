@@ -138,8 +138,6 @@ pub fn bilinear(c: &[Vec3<f64>; 4], t: f64, s: f64) -> Vec3<f64> {
     p0.scale((1.0 - t) * (1.0 - s)) + p1.scale(t * (1.0 - s)) + p2.scale(t * s) + p3.scale((1.0 - t) * s)
 }
 
-/// Bounds [min, max] of a cos θ + b sin θ over θ ∈ [θ₀, θ₁] (exact: the ends and the
-/// stationary points inside).
 /// The control points of the cubic Bézier segment `c` (over [0, 1]) restricted to [a, b]: its
 /// blossom at (a, a, a), (a, a, b), (a, b, b), (b, b, b).
 fn cubic_sub_segment(c: [Vec3<f64>; 4], a: f64, b: f64) -> [Vec3<f64>; 4] {
@@ -169,6 +167,8 @@ fn bezier_sub_net(control: &[[Vec3<f64>; 4]; 4], r: Rect) -> [[Vec3<f64>; 4]; 4]
     net
 }
 
+/// Bounds [min, max] of a cos θ + b sin θ over θ ∈ [θ₀, θ₁] (exact: the ends and the
+/// stationary points inside).
 fn trig_range(a: f64, b: f64, t0: f64, t1: f64) -> (f64, f64) {
     let f = |t: f64| a * t.cos() + b * t.sin();
     let (mut lo, mut hi) = (f(t0).min(f(t1)), f(t0).max(f(t1)));
@@ -389,6 +389,38 @@ impl Geom {
                 },
                 Err(_) => (-f64::MAX, f64::MAX),
             },
+        }
+    }
+
+    /// Balls (centre, radius; points have radius 0) whose union's convex hull holds the patch
+    /// on `rect`: the corners of a flat patch with straight edges, a Bézier patch's sub-net,
+    /// the two end circles of a tube's or cone's patch (each point is the convex combination of
+    /// the end circles' points at its θ), the whole disk or sphere. A convex 1-Lipschitz
+    /// function (the distance from a point or a line) is at most max(f(c) + ρ) over them.
+    #[must_use]
+    pub fn cover(&self, rect: Rect) -> Vec<(Vec3<f64>, f64)> {
+        match *self {
+            Self::Parallelogram { origin, edge_t, edge_s } => {
+                corners(origin, edge_t, edge_s, rect).map(|x| (x, 0.0)).collect()
+            }
+            Self::Quadrilateral { corners } => {
+                [(rect.t0, rect.s0), (rect.t1, rect.s0), (rect.t1, rect.s1), (rect.t0, rect.s1)]
+                    .into_iter()
+                    .map(|(t, s)| (bilinear(&corners, t, s), 0.0))
+                    .collect()
+            }
+            Self::Bezier { control } => {
+                bezier_sub_net(&control, rect).into_iter().flatten().map(|x| (x, 0.0)).collect()
+            }
+            Self::Disk { center, outer, .. } => vec![(center, outer)],
+            Self::Sphere { center, radius, .. } => vec![(center, radius)],
+            Self::Cylinder { base, frame, radius, .. } => {
+                [rect.s0, rect.s1].into_iter().map(|z| (base + frame.axis.scale(z), radius)).collect()
+            }
+            Self::Cone { base, frame, base_radius, top_radius, height, .. } => [rect.s0, rect.s1]
+                .into_iter()
+                .map(|z| (base + frame.axis.scale(z), base_radius + (top_radius - base_radius) * z / height))
+                .collect(),
         }
     }
 }
