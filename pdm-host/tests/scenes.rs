@@ -220,8 +220,7 @@ subdivide = [6, 3]
 /// A flat closed tube (height 0.05 of its radius): the wall bounds a convex solid holding both
 /// disks, so it is no occluder of the disk pair, nor of a disk with the wall, nor are the
 /// disks of the wall with itself (their planes). Bottom → top by C-41, the rest by the sum
-/// rule and reciprocity. With the wall as an occluder of the disk pair the scene did not
-/// finish in 15 minutes.
+/// rule and reciprocity. No pair has an occluder.
 #[test]
 fn flat_closed_tube_against_c41_and_the_sum_rule() {
     let s = scene(
@@ -269,10 +268,9 @@ side = "inner"
 
 /// A pipe through an annular chamber: an inner tube (outer side) inside an outer tube (inner
 /// side), closed by two annuli. The outer tube's solid holds every patch, so it occludes
-/// nothing; the inner tube occludes the pairs that see across it. Before, a whole tube's
-/// enclosing ball (centred off the axis) failed the containment test, and the outer tube was
-/// an occluder of an annulus with the inner tube: 74 s at tolerance 1e-3 for one pair that
-/// takes 0.05 s with no occluder. Order 4, so that the pairs across the inner tube are cheap;
+/// nothing (a whole tube's enclosing ball, centred off its axis, would not show it: the pipe is
+/// bounded by its end circles); the pipe occludes the pairs that see across it. Order 4, so
+/// that the pairs across the pipe are cheap;
 /// the values are only checked against the physical bounds (each factor in [0, 1]) and each
 /// row against 1 to within order 4's error.
 #[test]
@@ -336,8 +334,7 @@ side = "outer"
 
 /// A sphere's inside in three zones about a tilted axis and, separately, in three lunes, each
 /// cut 2 × 3: a chord of a ball never leaves it, so no zone (lune) occludes a pair of the
-/// others, and every factor is A_j/(4πR²) (`sphere_interior_factor`, exact). The zones were
-/// occluders of each other's pairs, and three of them did not finish in 240 s.
+/// others, and every factor is A_j/(4πR²) (`sphere_interior_factor`, exact).
 #[test]
 fn zones_and_lunes_of_a_sphere_inside_do_not_occlude_each_other() {
     let radius = 1.5;

@@ -161,26 +161,33 @@ struct PatchInfo<T> {
 /// sphere, tube or cone, either side, whole or a part) lies on the boundary of: a segment
 /// between two points of that solid stays inside it, which its surface cannot cut.
 /// Conservative: `false` when unsure, and for every other kind.
+///
+/// The slack is `tol` but at most 1e-12 of the solid's extent (the rounding of points computed
+/// on its boundary): a surface just outside the solid, which the solid's surface does block
+/// from itself, must not pass for one inside it.
 fn inside_solid(solid: &Geom, geom: &Geom, p: &ScenePatch, ball: (Vec3<f64>, f64), tol: f64) -> bool {
     let (bc, br) = ball;
     // Points and circles whose hull holds the patch (`Geom::cover`); the patch's enclosing
-    // ball is a second bound, tighter for a small cell of a large surface.
-    let cover = geom.cover(p.rect);
+    // ball is a second bound, tighter for a small cell of a large surface. Comparisons are
+    // written so that a NaN fails them.
     match *solid {
         Geom::Sphere { center, radius, .. } => {
-            let reach = cover.iter().map(|&(c, r)| (c - center).norm() + r).fold(0.0, f64::max);
-            reach.min((bc - center).norm() + br) <= radius + tol
+            let tol = tol.min(1e-12 * (center.norm() + radius));
+            let reach = |c: Vec3<f64>, r: f64| (c - center).norm() + r <= radius + tol;
+            geom.cover(p.rect).iter().all(|&(c, r)| reach(c, r)) || reach(bc, br)
         }
         // A tube (r₀ = r₁) or a cone or frustum bounds a convex solid: 0 ≤ z ≤ h along the axis,
         // distance from the axis ≤ r(z) = r₀ + (r₁ − r₀)·z/h, linear in z. A point of the cover
         // is checked against the radius at its own z; a circle or ball of radius ρ against the
-        // smaller radius over its axial span (its centre's z ± ρ, within the patch's).
+        // smaller radius over its axial span (its centre's z ± ρ, within the patch's: the
+        // cover's circles are the patch's own edges or hold the whole patch).
         Geom::Cylinder { base, frame, radius: base_radius, height, .. }
         | Geom::Cone { base, frame, base_radius, height, .. } => {
             let top_radius = match *solid {
                 Geom::Cone { top_radius, .. } => top_radius,
                 _ => base_radius,
             };
+            let tol = tol.min(1e-12 * (base.norm() + base_radius.max(top_radius) + height));
             let axial = Plane { origin: base, normal: frame.axis };
             let (lo, hi) = geom.distance_range(p.rect, &axial);
             if !(lo >= -tol && hi <= height + tol) {
@@ -192,7 +199,7 @@ fn inside_solid(solid: &Geom, geom: &Geom, p: &ScenePatch, ball: (Vec3<f64>, f64
             };
             let radius_at = |z: f64| base_radius + (top_radius - base_radius) * (z / height).clamp(0.0, 1.0);
             let least_radius = |z0: f64, z1: f64| radius_at(z0.max(lo)).min(radius_at(z1.min(hi)));
-            let by_cover = cover.iter().all(|&(c, r)| {
+            let by_cover = geom.cover(p.rect).iter().all(|&(c, r)| {
                 let z = (c - base).dot(frame.axis);
                 radial(c) + r <= least_radius(z - r, z + r) + tol
             });
@@ -625,4 +632,127 @@ pub fn merge(parts: Vec<MatrixResult>) -> Result<MatrixResult, String> {
     // The whole run's order (row by row), so that the sums come out the same to the bit.
     merged.pairs.sort_by_key(|p| (p.i, p.j));
     Ok(merged)
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing)]
+
+    use super::*;
+    use crate::scene::shape::Rect;
+    use pdm_kernel::{vec3, Frame};
+
+    fn patch(rect: Rect) -> ScenePatch {
+        ScenePatch { surface: 0, piece: 0, cell: (0, 0), rect }
+    }
+
+    fn frame() -> Frame<f64> {
+        Frame::from_axis(vec3(0.0, 0.0, 1.0)).unwrap()
+    }
+
+    /// `inside_solid` with the enclosing-ball fallback disabled (a ball far away), so that the
+    /// cover decides.
+    fn inside(solid: &Geom, geom: &Geom, rect: Rect) -> bool {
+        inside_solid(solid, geom, &patch(rect), (vec3(1e3, 0.0, 0.0), 1.0), 1e-9)
+    }
+
+    fn sphere(radius: f64) -> Geom {
+        Geom::Sphere { center: vec3(0.0, 0.0, 0.0), radius, frame: frame(), inner: false }
+    }
+
+    fn tube(radius: f64, height: f64) -> Geom {
+        Geom::Cylinder { base: vec3(0.0, 0.0, 0.0), frame: frame(), radius, height, inner: false }
+    }
+
+    fn whole(geom: &Geom) -> Rect {
+        geom.domain()
+    }
+
+    /// A sphere just outside another (1e-10 of its radius, below the scene's slack of 1e-9 but
+    /// above rounding) is not inside it: the inner sphere blocks the outer one's chords.
+    #[test]
+    fn a_shell_just_outside_a_ball_is_not_inside() {
+        let (core, shell) = (sphere(1.0), sphere(1.0 + 1e-10));
+        assert!(!inside(&core, &shell, whole(&shell)));
+        assert!(inside(&shell, &core, whole(&core)));
+        assert!(inside(&core, &core, whole(&core)), "a sphere's own cells lie in its ball");
+    }
+
+    /// The disks closing a tube, a coaxial tube inside it and a cone's top disk are inside;
+    /// the same moved off the axis or widened are not.
+    #[test]
+    fn tubes_cones_and_disks_in_a_tube_or_frustum() {
+        let (outer, pipe) = (tube(1.0, 1.0), tube(0.5, 1.0));
+        let disk =
+            |z: f64, x: f64, outer: f64| Geom::Disk { center: vec3(x, 0.0, z), frame: frame(), inner: 0.0, outer };
+        assert!(inside(&outer, &pipe, whole(&pipe)), "a coaxial pipe, by its end circles");
+        assert!(inside(&outer, &disk(1.0, 0.0, 1.0), whole(&disk(1.0, 0.0, 1.0))));
+        assert!(!inside(&outer, &disk(1.0, 1e-6, 1.0), whole(&disk(1.0, 1e-6, 1.0))));
+        assert!(!inside(&outer, &disk(1.0 + 1e-6, 0.0, 0.5), whole(&disk(1.0 + 1e-6, 0.0, 0.5))), "above the top");
+        let shifted =
+            Geom::Cylinder { base: vec3(0.6, 0.0, 0.0), frame: frame(), radius: 0.5, height: 1.0, inner: false };
+        assert!(!inside(&outer, &shifted, whole(&shifted)));
+        let frustum = Geom::Cone {
+            base: vec3(0.0, 0.0, 0.0),
+            frame: frame(),
+            base_radius: 1.0,
+            top_radius: 0.4,
+            height: 1.5,
+            inner: true,
+        };
+        assert!(inside(&frustum, &disk(1.5, 0.0, 0.4), whole(&disk(1.5, 0.0, 0.4))));
+        assert!(!inside(&frustum, &disk(1.5, 0.0, 0.4 + 1e-6), whole(&disk(1.5, 0.0, 0.4 + 1e-6))));
+        // A disk of radius 0.7 halfway up fits (r(0.75) = 0.7), one of 0.71 does not.
+        assert!(inside(&frustum, &disk(0.75, 0.0, 0.7), whole(&disk(0.75, 0.0, 0.7))));
+        assert!(!inside(&frustum, &disk(0.75, 0.0, 0.71), whole(&disk(0.75, 0.0, 0.71))));
+        // A quarter of the pipe's wall by its own end circles.
+        let quarter = Rect::new(0.0, core::f64::consts::FRAC_PI_2, 0.25, 0.75).unwrap();
+        assert!(inside(&outer, &pipe, quarter));
+    }
+
+    /// Every point of a patch is within max(f(c) + ρ) of the cover, for f the distance from a
+    /// point and from a line: sampled on tube, cone, disk and sphere patches.
+    #[test]
+    fn the_cover_bounds_sampled_points() {
+        let tilted = Frame::from_axis(vec3(0.3, -0.5, 0.8)).unwrap();
+        let geoms = [
+            Geom::Cylinder { base: vec3(0.2, 0.1, -0.3), frame: tilted, radius: 0.7, height: 1.3, inner: false },
+            Geom::Cone {
+                base: vec3(0.2, 0.1, -0.3),
+                frame: tilted,
+                base_radius: 0.9,
+                top_radius: 0.2,
+                height: 1.1,
+                inner: true,
+            },
+            Geom::Disk { center: vec3(0.4, -0.2, 0.5), frame: tilted, inner: 0.3, outer: 0.8 },
+            Geom::Sphere { center: vec3(-0.1, 0.3, 0.2), radius: 0.6, frame: tilted, inner: false },
+        ];
+        let (point, axis_point, axis) = (vec3(1.5, -0.7, 0.9), vec3(-0.4, 0.2, 0.1), vec3(0.6, 0.8, 0.0));
+        let to_line = |x: Vec3<f64>| {
+            let d = x - axis_point;
+            (d - axis.scale(d.dot(axis))).norm()
+        };
+        for geom in &geoms {
+            let shape = geom.shape::<f64>().unwrap();
+            let d = geom.domain();
+            let rect =
+                Rect::new(d.t0 + 0.1 * (d.t1 - d.t0), d.t0 + 0.6 * (d.t1 - d.t0), d.s0 + 0.2 * (d.s1 - d.s0), d.s1)
+                    .unwrap();
+            let cover = geom.cover(rect);
+            let bound = |f: &dyn Fn(Vec3<f64>) -> f64| cover.iter().map(|&(c, r)| f(c) + r).fold(f64::MIN, f64::max);
+            let (to_point, line) = (bound(&|x| (x - point).norm()), bound(&to_line));
+            for i in 0..=20 {
+                for j in 0..=20 {
+                    let (t, s) = (
+                        rect.t0 + (rect.t1 - rect.t0) * i as f64 / 20.0,
+                        rect.s0 + (rect.s1 - rect.s0) * j as f64 / 20.0,
+                    );
+                    let x = pdm_kernel::Surface::point(&shape, t, s);
+                    assert!((x - point).norm() <= to_point + 1e-12, "{geom:?} at ({t}, {s})");
+                    assert!(to_line(x) <= line + 1e-12, "{geom:?} at ({t}, {s})");
+                }
+            }
+        }
+    }
 }

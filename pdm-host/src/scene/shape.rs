@@ -397,6 +397,9 @@ impl Geom {
     /// the two end circles of a tube's or cone's patch (each point is the convex combination of
     /// the end circles' points at its θ), the whole disk or sphere. A convex 1-Lipschitz
     /// function (the distance from a point or a line) is at most max(f(c) + ρ) over them.
+    /// Each ball is either a point or circle of the patch itself (the circles are its edges)
+    /// or holds the whole patch, so the points the hull needs lie within the patch's own
+    /// extent along any direction (`inside_solid` relies on that).
     #[must_use]
     pub fn cover(&self, rect: Rect) -> Vec<(Vec3<f64>, f64)> {
         match *self {
