@@ -206,9 +206,15 @@ impl<T: Real> Occluder<T> for SceneOccluder<T> {
             Self::Part(_) => false,
         }
     }
-    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
+    fn event_quadrics(
+        &self,
+        corner: Vec3<T>,
+        edge: Vec3<T>,
+        pair: [&[Vec3<T>]; 2],
+        out: &mut dyn FnMut(Quadric<T>),
+    ) -> bool {
         match self {
-            Self::Whole(o) => o.event_quadrics(corner, edge, out),
+            Self::Whole(o) => o.event_quadrics(corner, edge, pair, out),
             Self::Part(_) => false,
         }
     }

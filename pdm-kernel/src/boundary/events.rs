@@ -38,7 +38,8 @@ use crate::visibility::Quadric;
 pub(crate) const MAX_EVENT_CURVES: usize = 5 * QUADRICS_PER_CORNER + 1;
 
 /// Most quadrics one corner may give: one occluder's (a sphere's tangent cone from the corner
-/// and its two tangent planes through the edge). Where more come, several occluders cast
+/// and its two tangent planes through the edge; a tube's two tangent planes through the corner
+/// parallel to its axis). Where more come, several occluders cast
 /// shadows on b, and where two shadows meet (one inside the other's edge, or touching) J
 /// changes structure on curves that are no occluder's quadrics: the events are declined and
 /// the outer rule samples across them as before.
@@ -197,13 +198,15 @@ impl<T: Real, const N: usize, const SB: usize, const TB: usize> Events<T, N, SB,
         self.graded_sides.get(k).copied().unwrap_or(false) && self.limit.is_some_and(|l| at(l) == x)
     }
 
-    /// The events of outer a (affine map `outer`: p = o + t·e_t + s·e_s) against inner b (affine
+    /// The events of outer a (affine map `outer`: p = o + t·e_t + s·e_s, over the parameter
+    /// rectangle `outer_rect`) against inner b (affine
     /// map `inner` over the parameter rectangle `rect`) across `occluders`, at the corners and
     /// edges of the part of b in front of a's plane; `None` if an occluder cannot give its
     /// quadrics, more than one occluder gives them ([`QUADRICS_PER_CORNER`]), or a coefficient
     /// is not finite.
     pub(super) fn new<O: Occluder<T> + ?Sized>(
         outer: (Vec3<T>, Vec3<T>, Vec3<T>),
+        outer_rect: ParamRect<T>,
         inner: (Vec3<T>, Vec3<T>, Vec3<T>),
         rect: ParamRect<T>,
         occluders: &O,
@@ -215,7 +218,8 @@ impl<T: Real, const N: usize, const SB: usize, const TB: usize> Events<T, N, SB,
         // The part of b that a's points see (`front_part`: b clipped by a's plane where it
         // straddles it) has the corners and edges whose quadrics are the events.
         let (front, n_front) = front_part(outer, bo, &map_corners(inner, rect));
-        overflow |= !events.push_edge_quadrics(outer, front.get(..n_front).unwrap_or_default(), occluders)?;
+        let (a_corners, b_corners) = (map_corners(outer, outer_rect), front.get(..n_front).unwrap_or_default());
+        overflow |= !events.push_edge_quadrics(outer, &a_corners, b_corners, occluders)?;
         // b's plane: b faces p only on its front side.
         let nb = bt.cross(bs);
         overflow |= !events.push([T::ZERO, T::ZERO, T::ZERO, nb.dot(et), nb.dot(es), nb.dot(o - bo)], None);
@@ -255,6 +259,7 @@ impl<T: Real, const N: usize, const SB: usize, const TB: usize> Events<T, N, SB,
     pub(super) fn push_edge_quadrics<O: Occluder<T> + ?Sized>(
         &mut self,
         outer: (Vec3<T>, Vec3<T>, Vec3<T>),
+        outer_corners: &[Vec3<T>],
         corners: &[Vec3<T>],
         occluders: &O,
     ) -> Option<bool> {
@@ -263,7 +268,7 @@ impl<T: Real, const N: usize, const SB: usize, const TB: usize> Events<T, N, SB,
         for k in 0..count {
             let (Some(&c), Some(&next)) = (corners.get(k), corners.get((k + 1) % count)) else { return None };
             let mut given = 0usize;
-            let supported = occluders.event_quadrics(c, next - c, &mut |q| {
+            let supported = occluders.event_quadrics(c, next - c, [outer_corners, corners], &mut |q| {
                 given += 1;
                 fitted &= self.push_quadric(outer, q);
             });

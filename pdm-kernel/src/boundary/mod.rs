@@ -9,8 +9,8 @@
 //!
 //! * **Along a t-line**, the parameters t where visibility changes are found — in closed form
 //!   when b is a parallelogram ([`Surface::affine_map`]) and every occluder gives its
-//!   polynomials ([`Occluder::line_polynomials`]: sphere, parallelogram, disk, and their
-//!   combinations): the roots of the two facing tests (linear in t) and of the occluders'
+//!   polynomials ([`Occluder::line_polynomials`]: sphere, parallelogram, quadrilateral, disk,
+//!   tube, cone, and their combinations): the roots of the two facing tests (linear in t) and of the occluders'
 //!   quadratics, each piece between roots classified by the exact test at its midpoint; when
 //!   b's t-lines are circles on which both facing tests are first-degree trigonometric
 //!   polynomials ([`Surface::facing_along_t`]: a sphere's meridians, a cylinder's or a cone's
@@ -36,11 +36,13 @@
 //! point/face/radius cases at order 24). What remains non-smooth is the **outer** integrand
 //! J(p), on curves of face a where a shadow boundary becomes tangent to an edge of b or passes
 //! through a corner. Where a and b are both parallelograms, b lies on one side of a's plane,
-//! and one occluder gives these curves ([`Occluder::event_quadrics`]: the sphere; with several,
-//! where two shadows meet is no occluder's curve), they are conics in a's parameters and
+//! and one occluder gives these curves ([`Occluder::event_quadrics`]: the sphere; a tube whose
+//! rims the pair keeps clear of, with both patches outside it: two planes per corner of b; with
+//! several, where two shadows meet is no occluder's curve), they are conics in a's parameters and
 //! are placed into the outer rule the same way (`events.rs`): whole faces across a sphere then
 //! converge exponentially (cube faces against the independent reference: 1.3e-8 / 1.6e-11 at
-//! orders 8 / 12, `pdm-host/tests/outer_events.rs`). Across flat convex occluders that are
+//! orders 8 / 12, `pdm-host/tests/outer_events.rs`), and so do squares across a long tube (1e-8 /
+//! 1e-12 / 1e-16 at orders 8 / 12 / 16, `tests/integration/tests/adaptive.rs`). Across flat convex occluders that are
 //! one polygon or the facets of one convex solid ([`Occluder::shadow_casters`]), the curves are
 //! lines: planes through an occluder vertex and an edge of b, through a corner of b and an
 //! occluder edge, and the facets' planes (`polygon_events.rs`; a half-plane screen between two
@@ -334,6 +336,7 @@ where
     let events = match surface.affine_map() {
         Some(outer_map) => pair_events(
             outer_map,
+            a.rect(),
             inner.surface,
             inner.r,
             inner.affine,
@@ -544,13 +547,15 @@ where
     TrigonometricEvents::new(surface, affine?, r)
 }
 
-/// The outer events of a flat outer patch (affine map `outer_map`) against the inner patch
+/// The outer events of a flat outer patch (affine map `outer_map` over `outer_rect`) against the inner patch
 /// (`surface` over `r`, inside `bounds`; `affine` its map where its lines are in closed form):
 /// a flat inner patch across the occluders when `use_occluders` (else across none), a curved
 /// one only where no occluder cuts.
 #[cfg(feature = "closed-form")]
+#[allow(clippy::too_many_arguments)]
 fn pair_events<T, SB, O>(
     outer_map: (Vec3<T>, Vec3<T>, Vec3<T>),
+    outer_rect: ParamRect<T>,
     surface: &SB,
     r: ParamRect<T>,
     affine: Option<(Vec3<T>, Vec3<T>, Vec3<T>)>,
@@ -564,8 +569,8 @@ where
     O: Occluder<T> + ?Sized,
 {
     match (affine, use_occluders) {
-        (Some(inner_map), true) => Events::new(outer_map, inner_map, r, occluders),
-        (Some(inner_map), false) => Events::new(outer_map, inner_map, r, &()),
+        (Some(inner_map), true) => Events::new(outer_map, outer_rect, inner_map, r, occluders),
+        (Some(inner_map), false) => Events::new(outer_map, outer_rect, inner_map, r, &()),
         (None, false) => Events::curved(outer_map, surface, r, bounds),
         (None, true) => None,
     }
@@ -614,7 +619,7 @@ where
     let use_occluders = occluders.may_block_between(&outer.enclosing_ball(), &bounds);
     match outer.surface().affine_map() {
         Some(outer_map) => {
-            if pair_events(outer_map, surface, r, affine, use_occluders, occluders, &bounds).is_some() {
+            if pair_events(outer_map, outer.rect(), surface, r, affine, use_occluders, occluders, &bounds).is_some() {
                 return Some(true);
             }
             let inner_map = affine.filter(|_| use_occluders)?;

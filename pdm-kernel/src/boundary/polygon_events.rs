@@ -1287,7 +1287,7 @@ impl<T: Real> PolygonEvents<T> {
             // `Events::new`.
             let sphere = Sphere::outer(ball.center, ball.radius).ok()?;
             events.set_grade(true);
-            room &= events.push_edge_quadrics(outer, front, &sphere)?;
+            room &= events.push_edge_quadrics(outer, &ac, front, &sphere)?;
             events.set_grade(near);
             *hulls.get_mut(usize::from(solids))? = Some(Hull::of_ball(&ball));
         }

@@ -94,9 +94,16 @@ impl<T: Real> Occluder<T> for AnyOccluder<T> {
         }
     }
     #[cfg(feature = "closed-form")]
-    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
+    fn event_quadrics(
+        &self,
+        corner: Vec3<T>,
+        edge: Vec3<T>,
+        pair: [&[Vec3<T>]; 2],
+        out: &mut dyn FnMut(Quadric<T>),
+    ) -> bool {
         match self {
-            Self::Sphere(o) => o.event_quadrics(corner, edge, out),
+            Self::Sphere(o) => o.event_quadrics(corner, edge, pair, out),
+            Self::Cylinder(o) => o.event_quadrics(corner, edge, pair, out),
             _ => false,
         }
     }
@@ -121,7 +128,13 @@ impl<T: Real> Occluder<T> for () {
         true
     }
     #[cfg(feature = "closed-form")]
-    fn event_quadrics(&self, _corner: Vec3<T>, _edge: Vec3<T>, _out: &mut dyn FnMut(Quadric<T>)) -> bool {
+    fn event_quadrics(
+        &self,
+        _corner: Vec3<T>,
+        _edge: Vec3<T>,
+        _pair: [&[Vec3<T>]; 2],
+        _out: &mut dyn FnMut(Quadric<T>),
+    ) -> bool {
         true
     }
 }
@@ -156,8 +169,14 @@ impl<T: Real, O: Occluder<T> + ?Sized> Occluder<T> for &O {
         (**self).shadow_sphere(a, b)
     }
     #[cfg(feature = "closed-form")]
-    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
-        (**self).event_quadrics(corner, edge, out)
+    fn event_quadrics(
+        &self,
+        corner: Vec3<T>,
+        edge: Vec3<T>,
+        pair: [&[Vec3<T>]; 2],
+        out: &mut dyn FnMut(Quadric<T>),
+    ) -> bool {
+        (**self).event_quadrics(corner, edge, pair, out)
     }
 }
 
@@ -191,8 +210,14 @@ impl<T: Real, O: Occluder<T>> Occluder<T> for [O] {
         self.iter().try_fold(None, |one, o| one_shadow(Some(one), o.shadow_sphere(a, b)))
     }
     #[cfg(feature = "closed-form")]
-    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
-        self.iter().all(|o| o.event_quadrics(corner, edge, out))
+    fn event_quadrics(
+        &self,
+        corner: Vec3<T>,
+        edge: Vec3<T>,
+        pair: [&[Vec3<T>]; 2],
+        out: &mut dyn FnMut(Quadric<T>),
+    ) -> bool {
+        self.iter().all(|o| o.event_quadrics(corner, edge, pair, out))
     }
 }
 
@@ -226,8 +251,14 @@ impl<T: Real, O: Occluder<T>, const N: usize> Occluder<T> for [O; N] {
         self.as_slice().shadow_sphere(a, b)
     }
     #[cfg(feature = "closed-form")]
-    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
-        self.as_slice().event_quadrics(corner, edge, out)
+    fn event_quadrics(
+        &self,
+        corner: Vec3<T>,
+        edge: Vec3<T>,
+        pair: [&[Vec3<T>]; 2],
+        out: &mut dyn FnMut(Quadric<T>),
+    ) -> bool {
+        self.as_slice().event_quadrics(corner, edge, pair, out)
     }
 }
 
@@ -261,8 +292,14 @@ impl<T: Real, O: Occluder<T>, const N: usize> Occluder<T> for heapless::Vec<O, N
         self.as_slice().shadow_sphere(a, b)
     }
     #[cfg(feature = "closed-form")]
-    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
-        self.as_slice().event_quadrics(corner, edge, out)
+    fn event_quadrics(
+        &self,
+        corner: Vec3<T>,
+        edge: Vec3<T>,
+        pair: [&[Vec3<T>]; 2],
+        out: &mut dyn FnMut(Quadric<T>),
+    ) -> bool {
+        self.as_slice().event_quadrics(corner, edge, pair, out)
     }
 }
 
@@ -296,8 +333,14 @@ impl<T: Real, O: Occluder<T>> Occluder<T> for Option<O> {
         self.as_ref().map_or(Some(None), |o| o.shadow_sphere(a, b))
     }
     #[cfg(feature = "closed-form")]
-    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
-        self.as_ref().is_none_or(|o| o.event_quadrics(corner, edge, out))
+    fn event_quadrics(
+        &self,
+        corner: Vec3<T>,
+        edge: Vec3<T>,
+        pair: [&[Vec3<T>]; 2],
+        out: &mut dyn FnMut(Quadric<T>),
+    ) -> bool {
+        self.as_ref().is_none_or(|o| o.event_quadrics(corner, edge, pair, out))
     }
 }
 
@@ -331,8 +374,14 @@ impl<T: Real, A: Occluder<T>, B: Occluder<T>> Occluder<T> for (A, B) {
         one_shadow(self.0.shadow_sphere(a, b), self.1.shadow_sphere(a, b))
     }
     #[cfg(feature = "closed-form")]
-    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
-        self.0.event_quadrics(corner, edge, out) && self.1.event_quadrics(corner, edge, out)
+    fn event_quadrics(
+        &self,
+        corner: Vec3<T>,
+        edge: Vec3<T>,
+        pair: [&[Vec3<T>]; 2],
+        out: &mut dyn FnMut(Quadric<T>),
+    ) -> bool {
+        self.0.event_quadrics(corner, edge, pair, out) && self.1.event_quadrics(corner, edge, pair, out)
     }
 }
 
@@ -370,10 +419,16 @@ impl<T: Real, A: Occluder<T>, B: Occluder<T>, C: Occluder<T>> Occluder<T> for (A
         one_shadow(one_shadow(self.0.shadow_sphere(a, b), self.1.shadow_sphere(a, b)), self.2.shadow_sphere(a, b))
     }
     #[cfg(feature = "closed-form")]
-    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
-        self.0.event_quadrics(corner, edge, out)
-            && self.1.event_quadrics(corner, edge, out)
-            && self.2.event_quadrics(corner, edge, out)
+    fn event_quadrics(
+        &self,
+        corner: Vec3<T>,
+        edge: Vec3<T>,
+        pair: [&[Vec3<T>]; 2],
+        out: &mut dyn FnMut(Quadric<T>),
+    ) -> bool {
+        self.0.event_quadrics(corner, edge, pair, out)
+            && self.1.event_quadrics(corner, edge, pair, out)
+            && self.2.event_quadrics(corner, edge, pair, out)
     }
 }
 

@@ -44,6 +44,16 @@ impl<T: Real> Occluder<T> for Cone<T> {
             interior(tau) && in_height(tau)
         }
     }
+    /// As for the tube, with the radius r₀ + (r₁ − r₀) z / h along the axis; one polynomial
+    /// more: where the segment's direction crosses the cone's asymptotic directions (a root of
+    /// the quadric through infinity).
+    #[cfg(feature = "closed-form")]
+    fn line_polynomials(&self, p: Vec3<T>, origin: Vec3<T>, direction: Vec3<T>, out: &mut dyn FnMut([T; 3])) -> bool {
+        let k = (self.top_radius - self.base_radius) / self.height;
+        let (base, axis) = (self.base, self.frame.axis);
+        revolution_polynomials(base, axis, self.base_radius, k, self.height, p, origin, direction, out);
+        true
+    }
     fn may_block_between(&self, a: &Ball<T>, b: &Ball<T>) -> bool {
         let center = self.base + self.frame.axis.scale(self.height * T::HALF);
         let big = self.base_radius.max(self.top_radius);

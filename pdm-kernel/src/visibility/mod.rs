@@ -112,11 +112,21 @@ pub trait Occluder<T: Real> {
     /// `corner + edge`, passes to `out` quadrics F(p) such that the visible part of the inner
     /// patch seen from a point p changes its structure (this occluder's shadow boundary passing
     /// through the corner, or becoming tangent to the edge) only where some F(p) = 0 (extra
-    /// quadrics are harmless, a missing one is a bug), and returns `true`; or returns `false`
-    /// (the default: the caller then samples across those events).
+    /// quadrics are harmless, a missing one is a bug), for every p on the outer patch, and
+    /// returns `true`; or returns `false` (the default: the caller then samples across those
+    /// events). `pair` holds the outer patch's corners and those of the part of the inner
+    /// patch that it sees (convex polygons, in order around them): an occluder whose shadow has
+    /// more kinds of boundary than it can give curves for may still give them where the pair
+    /// keeps clear of the others (a tube whose rims no segment of the pair comes near).
     #[cfg(feature = "closed-form")]
-    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
-        let _ = (corner, edge, out);
+    fn event_quadrics(
+        &self,
+        corner: Vec3<T>,
+        edge: Vec3<T>,
+        pair: [&[Vec3<T>]; 2],
+        out: &mut dyn FnMut(Quadric<T>),
+    ) -> bool {
+        let _ = (corner, edge, pair, out);
         false
     }
 

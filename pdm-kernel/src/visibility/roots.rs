@@ -105,3 +105,60 @@ pub(super) fn crossing_of_quadric<T: Real>(a: T, b: T, c_p: T, c_q: T, scale: T,
 pub(super) fn on_surface<T: Real>(c: T, scale: T) -> bool {
     c.abs() <= (T::from_f64(64.0) * T::EPSILON + T::from_f64(16.0) * T::ELEMENTARY_ERROR) * scale
 }
+
+/// The polynomials along a line (contract of [`Occluder::line_polynomials`]) of a finite
+/// surface of revolution about the unit `axis` through `base`, of radius ρ(z) = `r0` + `k`·z
+/// at height z ∈ [0, `height`] (a tube: k = 0; a cone or frustum otherwise), seen from `p`
+/// towards x(τ) = origin + τ·direction. With w = x − p, A = p − base across the axis and
+/// ρ_p = ρ at p's height, the segment p + λw meets the quadric where
+/// α λ² + 2β λ + C = 0, α = |w⊥|² − k²w_ax², β = A·w⊥ − ρ_p k w_ax, C = |A|² − ρ_p²; the
+/// blocking crossings are the roots λ ∈ (0, 1) at heights in [0, h]. That set changes only where
+/// a root appears or vanishes (the discriminant β² − αC, the line tangent to the quadric), passes
+/// λ = 1 (x on the quadric) or λ = 0 (β = 0, for p on it), or passes a rim (the crossing of an
+/// end plane on the rim circle: |A_e w_ax + e w| = ρ_e |w_ax| as for a disk, e the plane's height
+/// above p), or where α changes sign (a root through infinity). All are of degree ≤ 2 in τ, built
+/// from dot products of w taken at most twice.
+#[cfg(feature = "closed-form")]
+#[allow(clippy::too_many_arguments)]
+pub(super) fn revolution_polynomials<T: Real>(
+    base: Vec3<T>,
+    axis: Vec3<T>,
+    r0: T,
+    k: T,
+    height: T,
+    p: Vec3<T>,
+    origin: Vec3<T>,
+    direction: Vec3<T>,
+    out: &mut dyn FnMut([T; 3]),
+) {
+    let across = |v: Vec3<T>| v - axis.scale(v.dot(axis));
+    let (w0, d) = (origin - p, direction);
+    let offset = p - base;
+    let (a, p_ax) = (across(offset), offset.dot(axis));
+    let (w0p, dp) = (across(w0), across(d));
+    let (w0a, da) = (w0.dot(axis), d.dot(axis));
+    let rho_p = r0 + k * p_ax;
+    let kk = k * k;
+    // α, β (β linear: β₀ + τβ₁) and C.
+    let alpha = [dp.norm2() - kk * da * da, T::TWO * (w0p.dot(dp) - kk * w0a * da), w0p.norm2() - kk * w0a * w0a];
+    let (beta0, beta1) = (a.dot(w0p) - rho_p * k * w0a, a.dot(dp) - rho_p * k * da);
+    let c = a.norm2() - rho_p * rho_p;
+    out([beta1 * beta1 - c * alpha[0], T::TWO * beta0 * beta1 - c * alpha[1], beta0 * beta0 - c * alpha[2]]);
+    out([T::ZERO, beta1, beta0]);
+    // x on the quadric: |A + w⊥|² − (ρ_p + k w_ax)².
+    let f0 = a + w0p;
+    let (g0, g1) = (rho_p + k * w0a, k * da);
+    out([dp.norm2() - g1 * g1, T::TWO * (f0.dot(dp) - g0 * g1), f0.norm2() - g0 * g0]);
+    if k != T::ZERO {
+        out(alpha);
+    }
+    // The rims: the end plane at height z crossed at distance ρ(z) from the axis.
+    for z in [T::ZERO, height] {
+        let e = z - p_ax;
+        let rho = r0 + k * z;
+        let pc = offset - axis.scale(z);
+        let (r_0, r_1) = (pc.scale(w0a) + w0.scale(e), pc.scale(da) + d.scale(e));
+        let q = rho * rho;
+        out([r_1.norm2() - q * da * da, T::TWO * (r_0.dot(r_1) - q * w0a * da), r_0.norm2() - q * w0a * w0a]);
+    }
+}

@@ -99,7 +99,13 @@ impl<T: Real> Occluder<T> for Sphere<T> {
     /// sphere: (v·(w × d))² = R²|d × v|², i.e. vᵀ(g gᵀ − R²(|d|² I − d dᵀ)) v = 0 with
     /// g = w × d (the two tangent planes through the line).
     #[cfg(feature = "closed-form")]
-    fn event_quadrics(&self, corner: Vec3<T>, edge: Vec3<T>, out: &mut dyn FnMut(Quadric<T>)) -> bool {
+    fn event_quadrics(
+        &self,
+        corner: Vec3<T>,
+        edge: Vec3<T>,
+        _pair: [&[Vec3<T>]; 2],
+        out: &mut dyn FnMut(Quadric<T>),
+    ) -> bool {
         let w = self.center - corner;
         let r2 = self.radius * self.radius;
         let k = w.norm2() - r2;

@@ -117,6 +117,7 @@ fn check_line_breaks<O: Occluder<f64>>(occluder: &O, seed: u64) -> usize {
 #[cfg(feature = "closed-form")]
 #[test]
 fn line_polynomials_vanish_at_every_change_of_visibility() {
+    use crate::surface::Cone;
     let sphere = Sphere::new(vec3(0.2, -0.1, 0.0), 1.3, Side::Outer).unwrap();
     let quad = Parallelogram::new(vec3(-1.0, -0.5, 0.3), vec3(2.0, 0.4, 0.1), vec3(-0.3, 1.5, 0.2)).unwrap();
     let disk = Disk::annulus(vec3(0.1, 0.2, -0.2), vec3(0.2, 0.1, 1.0), 0.4, 1.6).unwrap();
@@ -126,8 +127,19 @@ fn line_polynomials_vanish_at_every_change_of_visibility() {
     assert!(check_line_breaks(&disk, 3) > 100);
     let mixed = [AnyOccluder::Sphere(sphere), AnyOccluder::Parallelogram(quad), AnyOccluder::Disk(disk)];
     assert!(check_line_breaks(&mixed, 4) > 100);
+    // Tubes and cones, upright and tilted, a frustum widening or narrowing, a cone to its apex.
     let tube = Cylinder::new(vec3(0.0, 0.0, -1.0), vec3(0.0, 0.0, 1.0), 1.0, 2.0, Side::Outer).unwrap();
-    assert!(!tube.line_polynomials(vec3(0.0, 0.0, 3.0), vec3(0.0, 0.0, -3.0), vec3(1.0, 0.0, 0.0), &mut |_| {}));
+    let tilted = Cylinder::new(vec3(-0.3, 0.2, -1.2), vec3(0.4, -0.3, 1.0), 0.7, 2.5, Side::Outer).unwrap();
+    let frustum = Cone::new(vec3(0.1, 0.0, -1.0), vec3(0.2, 0.1, 1.0), 1.2, 0.4, 2.0, Side::Outer).unwrap();
+    let widening = Cone::new(vec3(0.0, 0.3, -0.8), vec3(-0.3, 0.2, 1.0), 0.3, 1.1, 1.7, Side::Outer).unwrap();
+    let apex = Cone::new(vec3(0.0, 0.0, -1.0), vec3(0.0, 0.0, 1.0), 1.0, 0.0, 2.0, Side::Outer).unwrap();
+    assert!(check_line_breaks(&tube, 5) > 100);
+    assert!(check_line_breaks(&tilted, 6) > 100);
+    assert!(check_line_breaks(&frustum, 7) > 100);
+    assert!(check_line_breaks(&widening, 8) > 100);
+    assert!(check_line_breaks(&apex, 9) > 100);
+    let mixed = [AnyOccluder::Cylinder(tilted), AnyOccluder::Cone(frustum), AnyOccluder::Sphere(sphere)];
+    assert!(check_line_breaks(&mixed, 10) > 100);
 }
 
 #[test]
@@ -526,7 +538,7 @@ fn sphere_event_quadrics_vanish_where_the_tangents_are() {
         let (c, d, p) = (rng.vec(4.0), rng.vec(2.0), rng.vec(4.0));
         let mut quadrics = [Quadric::cone(Vec3::ZERO, [0.0; 6]); 2];
         let mut n = 0;
-        assert!(sphere.event_quadrics(c, d, &mut |q| {
+        assert!(sphere.event_quadrics(c, d, [&[], &[]], &mut |q| {
             quadrics[n] = q;
             n += 1;
         }));
@@ -587,4 +599,72 @@ fn sphere_circle_envelope_vanishes_on_the_tangent_planes_along_the_circle() {
         }
     }
     assert!(off > 1900, "{off}");
+}
+
+/// A long tube between two squares whose segments keep clear of its rims, the whole placement
+/// turned at random: every corner gives the two planes through it parallel to the axis and
+/// tangent to the tube (a line of such a plane through the corner passes the axis at distance
+/// R), and crossing either plane beyond the line of tangency changes whether the corner is seen
+/// (each plane is where the shadow's edge passes the corner). Near a rim, with a square
+/// reaching into the cylinder, or with nothing to cut, the tube declines or gives nothing.
+#[test]
+#[cfg(feature = "closed-form")]
+fn cylinder_event_planes_are_where_the_shadow_passes_a_corner() {
+    let mut rng = Lcg(0x5851_f42d_4c95_7f2d);
+    let turn = |x: Vec3<f64>, k: Vec3<f64>, angle: f64| {
+        let (c, s) = (angle.cos(), angle.sin());
+        x.scale(c) + k.cross(x).scale(s) + k.scale(k.dot(x) * (1.0 - c))
+    };
+    let mut switched = 0;
+    for _ in 0..200 {
+        let k = rng.vec(1.0);
+        let k = k.scale(1.0 / k.norm());
+        let angle = 3.0 * rng.next();
+        let shift = rng.vec(5.0);
+        let place = |x: Vec3<f64>| turn(x, k, angle) + shift;
+        let square = |z: f64| [vec3(0.0, 0.0, z), vec3(1.0, 0.0, z), vec3(1.0, 1.0, z), vec3(0.0, 1.0, z)].map(place);
+        let (a, b) = (square(0.0), square(2.0));
+        let (r, x0, z0) = (0.2 + 0.2 * rng.next().abs(), 0.3 + 0.4 * rng.next().abs(), 0.8 + 0.4 * rng.next().abs());
+        let base = place(vec3(x0, -20.0, z0));
+        let axis = turn(vec3(0.0, 1.0, 0.0), k, angle);
+        let tube = Cylinder::new(base, axis, r, 40.0, Side::Outer).unwrap();
+        for (corner, next) in b.iter().zip(b.iter().cycle().skip(1)) {
+            let mut planes = [Quadric::plane(Vec3::ZERO, Vec3::ZERO); 2];
+            let mut n = 0;
+            assert!(tube.event_quadrics(*corner, *next - *corner, [&a, &b], &mut |q| {
+                planes[n.min(1)] = q;
+                n += 1;
+            }));
+            assert_eq!(n, 2);
+            for plane in planes {
+                let normal = plane.g.scale(1.0 / plane.g.norm());
+                assert!(normal.dot(axis).abs() < 1e-12, "parallel to the axis");
+                // The plane's distance from the axis is R.
+                assert!((normal.dot(base - *corner).abs() - r).abs() < 1e-12 * (1.0 + shift.norm()));
+                // Beyond the line of tangency, seen from the corner: the contact point is the
+                // axis point's foot on the plane; p lies past it in the plane, at a height along
+                // the axis within the tube.
+                let foot = base - normal.scale(normal.dot(base - *corner));
+                let along = axis.scale(axis.dot(*corner - base) + 2.0 * rng.next());
+                let contact = foot + along - axis.scale(axis.dot(foot - base));
+                let p = *corner + (contact - *corner).scale(1.5 + rng.next().abs());
+                let delta = 1e-6;
+                let (inside, outside) = (p + normal.scale(delta), p - normal.scale(delta));
+                if tube.blocks(inside, *corner) != tube.blocks(outside, *corner) {
+                    switched += 1;
+                }
+            }
+        }
+        // A tube ending over the squares (its rim in reach), a tube reaching into the lower
+        // square's cylinder, and a tube far to the side.
+        let short = Cylinder::new(place(vec3(x0, -20.0, z0)), axis, r, 20.5, Side::Outer).unwrap();
+        assert!(!short.event_quadrics(b[0], b[1] - b[0], [&a, &b], &mut |_| {}));
+        let low = Cylinder::new(place(vec3(x0, -20.0, 0.1)), axis, 0.3, 40.0, Side::Outer).unwrap();
+        assert!(!low.event_quadrics(b[0], b[1] - b[0], [&a, &b], &mut |_| {}));
+        let far = Cylinder::new(place(vec3(30.0, -20.0, z0)), axis, r, 40.0, Side::Outer).unwrap();
+        let mut given = 0;
+        assert!(far.event_quadrics(b[0], b[1] - b[0], [&a, &b], &mut |_| given += 1));
+        assert_eq!(given, 0);
+    }
+    assert!(switched >= 1560, "{switched} of 1600 plane crossings changed the view");
 }
