@@ -104,6 +104,7 @@ impl<T: Real> Occluder<T> for AnyOccluder<T> {
         match self {
             Self::Sphere(o) => o.event_quadrics(corner, edge, pair, out),
             Self::Cylinder(o) => o.event_quadrics(corner, edge, pair, out),
+            Self::Cone(o) => o.event_quadrics(corner, edge, pair, out),
             _ => false,
         }
     }

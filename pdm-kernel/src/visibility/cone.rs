@@ -54,6 +54,22 @@ impl<T: Real> Occluder<T> for Cone<T> {
         revolution_polynomials(base, axis, self.base_radius, k, self.height, p, origin, direction, out);
         true
     }
+    /// A frustum with equal radii is a tube: the tube's planes ([`Cylinder`]'s
+    /// `event_quadrics`). Other cones give none (`false`).
+    #[cfg(feature = "closed-form")]
+    fn event_quadrics(
+        &self,
+        corner: Vec3<T>,
+        edge: Vec3<T>,
+        pair: [&[Vec3<T>]; 2],
+        out: &mut dyn FnMut(Quadric<T>),
+    ) -> bool {
+        if self.top_radius != self.base_radius {
+            return false;
+        }
+        let (base, frame, radius, height, side) = (self.base, self.frame, self.base_radius, self.height, self.side);
+        Cylinder { base, frame, radius, height, side }.event_quadrics(corner, edge, pair, out)
+    }
     fn may_block_between(&self, a: &Ball<T>, b: &Ball<T>) -> bool {
         let center = self.base + self.frame.axis.scale(self.height * T::HALF);
         let big = self.base_radius.max(self.top_radius);

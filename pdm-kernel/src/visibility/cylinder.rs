@@ -31,8 +31,9 @@ impl<T: Real> Occluder<T> for Cylinder<T> {
         revolution_polynomials(base, axis, self.radius, T::ZERO, self.height, p, origin, direction, out);
         true
     }
-    /// Where the pair keeps clear of the tube's rims (no segment between the two polygons' balls
-    /// comes within R of an end's centre) and both polygons lie outside the infinite cylinder,
+    /// Where the pair keeps clear of the tube's rims (both polygons on one side of a rim's plane,
+    /// or no segment between their balls within R of its centre) and both polygons lie outside
+    /// the infinite cylinder,
     /// a segment of the pair is blocked exactly when its projection across the axis crosses
     /// the circle: the shadow on b is bounded by the traces of the two tangent planes from p
     /// parallel to the axis (their ends, the lines of tangency, lie on the tube, off b). Such a
@@ -55,8 +56,19 @@ impl<T: Real> Occluder<T> for Cylinder<T> {
         if !self.may_block_between(&ball_a, &ball_b) {
             return true;
         }
-        let top = self.base + axis.scale(self.height);
-        if ball_may_cut_pair(self.base, r, &ball_a, &ball_b) || ball_may_cut_pair(top, r, &ball_a, &ball_b) {
+        // A rim no segment of the pair comes near: both polygons on one side of its plane (a
+        // segment then meets the plane at most at an end point, on a polygon that keeps clear
+        // of the cylinder, below), or the segments between the balls pass it farther than R.
+        let (mut low, mut high) = (T::MAX, -T::MAX);
+        for &c in a.iter().chain(b.iter()) {
+            let z = axis.dot(c - self.base);
+            (low, high) = (low.min(z), high.max(z));
+        }
+        let slack = T::GEOMETRY_TOLERANCE * (self.height + r + low.abs().max(high.abs()));
+        let clear = |z: T, centre: Vec3<T>| {
+            high <= z + slack || low >= z - slack || !ball_may_cut_pair(centre, r, &ball_a, &ball_b)
+        };
+        if !clear(T::ZERO, self.base) || !clear(self.height, self.base + axis.scale(self.height)) {
             return false;
         }
         if !clear_of_axis(a, self.base, axis, r) || !clear_of_axis(b, self.base, axis, r) {

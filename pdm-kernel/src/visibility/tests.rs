@@ -655,8 +655,30 @@ fn cylinder_event_planes_are_where_the_shadow_passes_a_corner() {
                 }
             }
         }
-        // A tube ending over the squares (its rim in reach), a tube reaching into the lower
-        // square's cylinder, and a tube far to the side.
+        // A tube from one side of the squares to the other (its rims in the planes of their
+        // edges) gives the planes too; one ending over the squares (its rim in reach), one
+        // reaching into the lower square's cylinder decline; one far to the side gives nothing.
+        let flush = Cylinder::new(place(vec3(x0, 0.0, z0)), axis, r, 1.0, Side::Outer).unwrap();
+        let mut given = 0;
+        assert!(flush.event_quadrics(b[0], b[1] - b[0], [&a, &b], &mut |_| given += 1));
+        assert_eq!(given, 2);
+        // A frustum with equal radii is the tube and gives its planes; a narrowing one none.
+        let (mut tube_planes, mut cone_planes) = ([None; 2], [None; 2]);
+        let twin = crate::surface::Cone::new(place(vec3(x0, 0.0, z0)), axis, r, r, 1.0, Side::Outer).unwrap();
+        let mut k = 0;
+        assert!(flush.event_quadrics(b[2], b[3] - b[2], [&a, &b], &mut |q| {
+            tube_planes[k.min(1)] = Some(q);
+            k += 1;
+        }));
+        k = 0;
+        assert!(twin.event_quadrics(b[2], b[3] - b[2], [&a, &b], &mut |q| {
+            cone_planes[k.min(1)] = Some(q);
+            k += 1;
+        }));
+        assert_eq!(tube_planes, cone_planes);
+        let narrowing =
+            crate::surface::Cone::new(place(vec3(x0, 0.0, z0)), axis, r, 0.5 * r, 1.0, Side::Outer).unwrap();
+        assert!(!narrowing.event_quadrics(b[2], b[3] - b[2], [&a, &b], &mut |_| {}));
         let short = Cylinder::new(place(vec3(x0, -20.0, z0)), axis, r, 20.5, Side::Outer).unwrap();
         assert!(!short.event_quadrics(b[0], b[1] - b[0], [&a, &b], &mut |_| {}));
         let low = Cylinder::new(place(vec3(x0, -20.0, 0.1)), axis, 0.3, 40.0, Side::Outer).unwrap();

@@ -395,8 +395,8 @@ fn tolerance_sweep<SA: Surface<f64>, SB: Surface<f64>, O: Occluder<f64>>(
 
 #[test]
 fn cylinder_between_parallel_squares() {
-    // Unit squares at z = 0 and 1 with a long tube (axis along y, rims far beyond the squares)
-    // between them. Along each inner line the tube's shadow is in closed form (its line
+    // Unit squares at z = 0 and 1 with a tube (axis along y, its rims beyond the squares or in
+    // the planes of their sides) between them. Along each inner line the tube's shadow is in closed form (its line
     // polynomials), and the planes through b's corners tangent to the tube, parallel to its
     // axis, are placed into the outer rule: the fixed orders converge exponentially and the
     // tolerances are met. The whole placement is also turned and moved (the reference does not
@@ -414,8 +414,10 @@ fn cylinder_between_parallel_squares() {
         let a = square(vec3(0.0, 0.0, 0.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0));
         let b = square(vec3(0.0, 0.0, 1.0), vec3(0.0, 1.0, 0.0), vec3(1.0, 0.0, 0.0));
         let (pa, pb) = (Patch::whole(&a).unwrap(), Patch::whole(&b).unwrap());
-        for (cx, cz, r) in [(0.5, 0.5, 0.25), (0.3, 0.4, 0.2)] {
-            let tube = Cylinder::new(at(vec3(cx, -1.0, cz)), along(vec3(0.0, 1.0, 0.0)), r, 3.0, Side::Outer).unwrap();
+        // The second tube ends flush with the squares' sides (a pipe from wall to wall): no
+        // segment between the squares meets its rims either.
+        for (cx, cz, r, y0, h) in [(0.5, 0.5, 0.25, -1.0, 3.0), (0.3, 0.4, 0.2, 0.0, 1.0)] {
+            let tube = Cylinder::new(at(vec3(cx, y0, cz)), along(vec3(0.0, 1.0, 0.0)), r, h, Side::Outer).unwrap();
             let reference = squares_with_cylinder(cx, cz, r);
             let name = format!("squares, tube r {r} at ({cx}, {cz}), turned {turned}");
             // Exponential: from order 8 to 16 at least four digits (down to rounding), and
@@ -509,11 +511,11 @@ fn bad_settings_are_refused() {
 
 #[test]
 fn limits_are_reported_as_not_converged() {
-    // The depth limit: parallel squares with a tube between them need far more halvings than
-    // depth 1 allows for 1e-8.
+    // The depth limit: parallel squares with a tube between them that ends over them (its rim's
+    // shadow has no outer events) need far more halvings than depth 1 allows for 1e-8.
     let floor = square([0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]);
     let ceiling = square([0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]);
-    let tube = Cylinder::new(vec3(0.5, -1.0, 0.5), vec3(0.0, 1.0, 0.0), 0.25, 3.0, Side::Outer).unwrap();
+    let tube = Cylinder::new(vec3(0.5, -1.0, 0.5), vec3(0.0, 1.0, 0.0), 0.25, 1.5, Side::Outer).unwrap();
     let (pa, pb) = (Patch::whole(&floor).unwrap(), Patch::whole(&ceiling).unwrap());
     let shallow = Adaptive { max_depth: 1, ..Adaptive::new(1e-8) };
     let e = adaptive_exchange::<f64, _, _, _, 144>(&pa, &pb, shallow, &tube).unwrap();
