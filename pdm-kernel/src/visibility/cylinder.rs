@@ -56,15 +56,20 @@ impl<T: Real> Occluder<T> for Cylinder<T> {
         if !self.may_block_between(&ball_a, &ball_b) {
             return true;
         }
-        // A rim no segment of the pair comes near: both polygons on one side of its plane (a
-        // segment then meets the plane at most at an end point, on a polygon that keeps clear
-        // of the cylinder, below), or the segments between the balls pass it farther than R.
+        // A rim no segment of the pair comes near: both polygons on one side of its plane, up
+        // to rounding (a segment then meets the plane at most at its end points, or lies in it,
+        // on polygons that keep clear of the cylinder, below), or the segments between the
+        // balls pass it farther than R.
         let (mut low, mut high) = (T::MAX, -T::MAX);
         for &c in a.iter().chain(b.iter()) {
             let z = axis.dot(c - self.base);
             (low, high) = (low.min(z), high.max(z));
         }
-        let slack = T::GEOMETRY_TOLERANCE * (self.height + r + low.abs().max(high.abs()));
+        let slack = T::from_f64(64.0) * T::EPSILON * (self.height + r + low.abs().max(high.abs()));
+        // Both beyond the same end: no segment between them meets the tube's side.
+        if high <= slack || low >= self.height - slack {
+            return true;
+        }
         let clear = |z: T, centre: Vec3<T>| {
             high <= z + slack || low >= z - slack || !ball_may_cut_pair(centre, r, &ball_a, &ball_b)
         };
@@ -112,8 +117,8 @@ fn polygon_ball<T: Real>(corners: &[Vec3<T>]) -> Option<Ball<T>> {
 /// the line through `base` along the unit `axis`. Across the axis each projected side must pass
 /// the line's point farther than `r`, and the point must not lie inside the projection: that
 /// needs every side to turn the same way about it, each by at least |side|·r (its distance
-/// from the side's line), which a projection flattened to a segment (a polygon parallel to the
-/// axis) never does.
+/// from the side's line; tested against half that), which a projection flattened to a segment
+/// (a polygon parallel to the axis) never does.
 #[cfg(feature = "closed-form")]
 fn clear_of_axis<T: Real>(corners: &[Vec3<T>], base: Vec3<T>, axis: Vec3<T>, r: T) -> bool {
     let across = |x: Vec3<T>| {

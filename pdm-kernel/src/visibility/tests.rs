@@ -74,6 +74,16 @@ fn cylinder_tube() {
 /// bracketed by two samples 1e-4 apart and must contain a candidate.
 #[cfg(feature = "closed-form")]
 fn check_line_breaks<O: Occluder<f64>>(occluder: &O, seed: u64) -> usize {
+    check_line_breaks_from(occluder, seed, |x, y, z| vec3(3.0 * x, 3.0 * y, 3.0 + z))
+}
+
+/// [`check_line_breaks`] with p = `point` of three numbers uniform in [−1, 1).
+#[cfg(feature = "closed-form")]
+fn check_line_breaks_from<O: Occluder<f64>>(
+    occluder: &O,
+    seed: u64,
+    point: impl Fn(f64, f64, f64) -> Vec3<f64>,
+) -> usize {
     let mut state = seed;
     let mut next = || {
         state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
@@ -81,7 +91,8 @@ fn check_line_breaks<O: Occluder<f64>>(occluder: &O, seed: u64) -> usize {
     };
     let mut changes = 0;
     for _ in 0..200 {
-        let p = vec3(3.0 * next(), 3.0 * next(), 3.0 + next());
+        let (x, y, z) = (next(), next(), next());
+        let p = point(x, y, z);
         let origin = vec3(3.0 * next(), 3.0 * next(), -3.0 + next());
         let direction = vec3(next(), next(), 0.3 * next()).scale(4.0);
         let mut candidates = [0.0f64; 64];
@@ -140,6 +151,19 @@ fn line_polynomials_vanish_at_every_change_of_visibility() {
     assert!(check_line_breaks(&apex, 9) > 100);
     let mixed = [AnyOccluder::Cylinder(tilted), AnyOccluder::Cone(frustum), AnyOccluder::Sphere(sphere)];
     assert!(check_line_breaks(&mixed, 10) > 100);
+    // Seen from beside the tube and the frustum, from inside them, and from points of their
+    // surfaces (a patch of the occluder itself: the second crossing passing p).
+    let around = |x: f64, y: f64, z: f64| vec3(2.0 * x, 2.0 * y, 1.5 * z);
+    assert!(check_line_breaks_from(&tube, 14, around) > 100);
+    assert!(check_line_breaks_from(&frustum, 15, around) > 100);
+    let on_tube = |x: f64, _: f64, z: f64| vec3((3.2 * x).cos(), (3.2 * x).sin(), z - 1e-3 * z.signum());
+    assert!(check_line_breaks_from(&tube, 16, on_tube) > 100);
+    let on_apex_cone = |x: f64, _: f64, z: f64| {
+        let height = 0.9 * z;
+        let radius = 1.0 - (height + 1.0) / 2.0;
+        vec3(radius * (3.2 * x).cos(), radius * (3.2 * x).sin(), height)
+    };
+    assert!(check_line_breaks_from(&apex, 17, on_apex_cone) > 100);
 }
 
 #[test]
@@ -665,15 +689,15 @@ fn cylinder_event_planes_are_where_the_shadow_passes_a_corner() {
         // A frustum with equal radii is the tube and gives its planes; a narrowing one none.
         let (mut tube_planes, mut cone_planes) = ([None; 2], [None; 2]);
         let twin = crate::surface::Cone::new(place(vec3(x0, 0.0, z0)), axis, r, r, 1.0, Side::Outer).unwrap();
-        let mut k = 0;
+        let mut count = 0;
         assert!(flush.event_quadrics(b[2], b[3] - b[2], [&a, &b], &mut |q| {
-            tube_planes[k.min(1)] = Some(q);
-            k += 1;
+            tube_planes[count.min(1)] = Some(q);
+            count += 1;
         }));
-        k = 0;
+        count = 0;
         assert!(twin.event_quadrics(b[2], b[3] - b[2], [&a, &b], &mut |q| {
-            cone_planes[k.min(1)] = Some(q);
-            k += 1;
+            cone_planes[count.min(1)] = Some(q);
+            count += 1;
         }));
         assert_eq!(tube_planes, cone_planes);
         let narrowing =
@@ -683,10 +707,25 @@ fn cylinder_event_planes_are_where_the_shadow_passes_a_corner() {
         assert!(!short.event_quadrics(b[0], b[1] - b[0], [&a, &b], &mut |_| {}));
         let low = Cylinder::new(place(vec3(x0, -20.0, 0.1)), axis, 0.3, 40.0, Side::Outer).unwrap();
         assert!(!low.event_quadrics(b[0], b[1] - b[0], [&a, &b], &mut |_| {}));
+        // A tube standing through the upper square (its axis pierces it between the rims)
+        // declines; one wholly beyond the squares' sides gives nothing; one whose rim plane the
+        // pair straddles far from the rim (a tube off to the side, 3 from the squares) gives
+        // its planes.
+        let (up, at_b) = (turn(vec3(0.0, 0.0, 1.0), k, angle), place(vec3(0.5, 0.5, 1.0)));
+        let pierced = Cylinder::new(at_b - up.scale(0.5), up, 0.1, 2.0, Side::Outer).unwrap();
+        assert!(!pierced.event_quadrics(b[0], b[1] - b[0], [&a, &b], &mut |_| {}));
+        let beyond = Cylinder::new(place(vec3(x0, 1.5, z0)), axis, r, 5.0, Side::Outer).unwrap();
+        let mut given = 0;
+        assert!(beyond.event_quadrics(b[0], b[1] - b[0], [&a, &b], &mut |_| given += 1));
+        assert_eq!(given, 0);
+        let aside = Cylinder::new(place(vec3(x0, 0.5, 5.0)), axis, r, 20.0, Side::Outer).unwrap();
+        let mut given = 0;
+        assert!(aside.event_quadrics(b[0], b[1] - b[0], [&a, &b], &mut |_| given += 1));
+        assert_eq!(given, 2);
         let far = Cylinder::new(place(vec3(30.0, -20.0, z0)), axis, r, 40.0, Side::Outer).unwrap();
         let mut given = 0;
         assert!(far.event_quadrics(b[0], b[1] - b[0], [&a, &b], &mut |_| given += 1));
         assert_eq!(given, 0);
     }
-    assert!(switched >= 1560, "{switched} of 1600 plane crossings changed the view");
+    assert_eq!(switched, 1600, "every plane crossing beyond the line of contact changes the view");
 }
