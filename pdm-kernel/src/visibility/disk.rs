@@ -35,12 +35,8 @@ impl<T: Real> Occluder<T> for Disk<T> {
         let (nw0, nd) = (n.dot(w0), n.dot(d));
         out([T::ZERO, nd, nw0]);
         out([T::ZERO, nd, nw0 - offset]);
-        let pc = p - self.center;
-        let r0 = pc.scale(nw0) + w0.scale(offset);
-        let r1 = pc.scale(nd) + d.scale(offset);
         for radius in [self.inner_radius, self.outer_radius] {
-            let k = radius * radius;
-            out([r1.norm2() - k * nd * nd, T::TWO * (r0.dot(r1) - k * nw0 * nd), r0.norm2() - k * nw0 * nw0]);
+            out(circle_crossing_polynomial(p - self.center, offset, (nw0, nd), (w0, d), radius));
         }
         true
     }

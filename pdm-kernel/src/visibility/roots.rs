@@ -154,11 +154,26 @@ pub(super) fn revolution_polynomials<T: Real>(
     }
     // The rims: the end plane at height z crossed at distance ρ(z) from the axis.
     for z in [T::ZERO, height] {
-        let e = z - p_ax;
-        let rho = r0 + k * z;
-        let pc = offset - axis.scale(z);
-        let (r_0, r_1) = (pc.scale(w0a) + w0.scale(e), pc.scale(da) + d.scale(e));
-        let q = rho * rho;
-        out([r_1.norm2() - q * da * da, T::TWO * (r_0.dot(r_1) - q * w0a * da), r_0.norm2() - q * w0a * w0a]);
+        out(circle_crossing_polynomial(offset - axis.scale(z), z - p_ax, (w0a, da), (w0, d), r0 + k * z));
     }
+}
+
+/// Where the segment from p to x(τ) = origin + τ·d crosses the plane of a circle (unit normal n,
+/// centre c, radius `radius`) on the circle: with `pc` = p − c, `offset` = n·(c − p), the
+/// crossing is p + (offset / n·w) w and its distance from c is |pc (n·w) + offset·w| / |n·w|,
+/// so |pc (n·w) + offset·w|² − radius² (n·w)² = 0, quadratic in τ; `normal_parts` = (n·w₀, n·d),
+/// `line` = (w₀, d) with w = w₀ + τ·d.
+#[cfg(feature = "closed-form")]
+pub(super) fn circle_crossing_polynomial<T: Real>(
+    pc: Vec3<T>,
+    offset: T,
+    normal_parts: (T, T),
+    line: (Vec3<T>, Vec3<T>),
+    radius: T,
+) -> [T; 3] {
+    let ((nw0, nd), (w0, d)) = (normal_parts, line);
+    let r0 = pc.scale(nw0) + w0.scale(offset);
+    let r1 = pc.scale(nd) + d.scale(offset);
+    let k = radius * radius;
+    [r1.norm2() - k * nd * nd, T::TWO * (r0.dot(r1) - k * nw0 * nd), r0.norm2() - k * nw0 * nw0]
 }
